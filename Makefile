@@ -1,0 +1,38 @@
+# stereo-servo: `make demo` runs the main job on embedded defaults, `make test` runs the tests.
+# Both create the virtual environment and install what they need on a fresh machine.
+
+SHELL := /bin/bash
+PYTHON ?= python3
+VENV ?= .venv
+BIN := $(VENV)/bin
+OUT ?= out
+DATA ?= $(abspath ../shared/data)
+# tests and benchmarks find the Middlebury scenes through this variable
+export STEREO_SERVO_DATA ?= $(if $(wildcard $(DATA)/middlebury/index.json),$(DATA),)
+
+.PHONY: demo test bench venv system-deps clean
+
+$(BIN)/.installed: pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/pip install --quiet --disable-pip-version-check -e '.[test]'
+	touch $@
+
+venv: $(BIN)/.installed
+
+system-deps:
+	@bash tools/system-deps.sh
+
+demo: venv
+	@mkdir -p $(OUT)
+	$(BIN)/host eval --picture $(OUT)
+	$(BIN)/host eval --matcher ncc --window 5 --border clip --lr-check 1 --fill --median 5
+	@echo "disparity picture: $(OUT)/motorcycle.png"
+
+test: venv system-deps
+	$(BIN)/python -m pytest
+
+bench: venv
+	$(BIN)/python bench/matcher.py
+
+clean:
+	rm -rf $(VENV) $(OUT) .pytest_cache

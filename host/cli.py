@@ -1,0 +1,37 @@
+"""The host command: subcommands for the stereo core, tuning, the link and the servo."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from host.commands import disparity, eval as eval_cmd
+from host.errors import HostError
+
+COMMANDS = [eval_cmd, disparity]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="host", description="stereo-servo host: stereo matching, tuning and the robot servo")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    for command in COMMANDS:
+        command.add_parser(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run a subcommand; a HostError becomes one line on stderr and exit status 2."""
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args.run(args))
+    except HostError as e:
+        print(f"host {args.command}: error: {e}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"host {args.command}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,79 @@
+"""host eval [SCENE ...]: score a matcher on scenes with ground truth (Middlebury v2 metric)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import time
+from pathlib import Path
+from typing import Any
+
+from host.commands.options import add_matcher_options, num_disp_given, params_from_args
+from host.errors import HostError
+from host.files import write_image_atomic
+from host.stereo.matcher import compute_disparity, warm_up
+from host.stereo.metrics import evaluate
+from host.stereo.params import MatcherParams
+from host.stereo.picture import colourise
+from host.stereo.scenes import Scene, load_scenes
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("eval", help="score a matcher against ground truth")
+    p.add_argument("scenes", nargs="*", type=Path, metavar="SCENE_DIR",
+                   help="scene folders, or folders of them (default: the embedded Motorcycle "
+                        "pair)")
+    p.add_argument("--scale", type=float, help="ground-truth scale for 2001/2003 layouts")
+    p.add_argument("--rho", type=float, default=1.0, help="bad-pixel threshold (px)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--picture", type=Path, metavar="DIR",
+                   help="write each scene's disparity picture into DIR")
+    add_matcher_options(p)
+    p.set_defaults(run=run)
+
+
+def score_scene(scene: Scene, params: MatcherParams, rho: float) -> dict[str, Any]:
+    """One row of the table: bad (all GT-known), bad_nonocc, rms, density (%), ms."""
+    warm_up(params)
+    t0 = time.perf_counter()
+    disp = compute_disparity(scene.left, scene.right, params)
+    ms = (time.perf_counter() - t0) * 1000
+    assert scene.gt is not None
+    whole = evaluate(disp, scene.gt, rho=rho)
+    nonocc = scene.masks.get("nonocc")
+    bad_nonocc = evaluate(disp, scene.gt, nonocc, rho).bad if nonocc is not None else None
+    return {"scene": scene.name, "bad": whole.bad, "bad_nonocc": bad_nonocc, "rms": whole.rms,
+            "density": whole.density, "ms": ms, "disp": disp}
+
+
+def _fmt(v: float | None, spec: str = ".2f") -> str:
+    return "-" if v is None or (isinstance(v, float) and math.isnan(v)) else format(v, spec)
+
+
+def run(args: argparse.Namespace) -> int:
+    params = params_from_args(args)
+    scenes = load_scenes(args.scenes, args.scale)
+    rows = []
+    for scene in scenes:
+        if scene.gt is None:
+            raise HostError(f"{scene.name}: no ground truth to evaluate against")
+        p = params if num_disp_given(args) else params.replace(
+            num_disparities=scene.num_disparities(16 if params.matcher.startswith("opencv")
+                                                  else 1))
+        row = score_scene(scene, p, args.rho)
+        if args.picture:
+            write_image_atomic(args.picture / f"{scene.name}.png",
+                               colourise(row["disp"], p.min_disparity + p.num_disparities))
+        rows.append(row)
+    out = [{k: (None if isinstance(v, float) and math.isnan(v) else v)
+            for k, v in r.items() if k != "disp"} for r in rows]
+    if args.json:
+        print(json.dumps({"matcher": params.to_dict(), "scenes": out}))
+        return 0
+    print(f"matcher {params.matcher}, window {params.block_size}, rho {args.rho} px")
+    print(f"{'scene':<16}{'bad%':>8}{'nonocc%':>9}{'rms':>8}{'density%':>10}{'ms':>9}")
+    for r in out:
+        print(f"{r['scene']:<16}{_fmt(r['bad']):>8}{_fmt(r['bad_nonocc']):>9}"
+              f"{_fmt(r['rms']):>8}{_fmt(r['density']):>10}{_fmt(r['ms'], '.1f'):>9}")
+    return 0

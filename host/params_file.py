@@ -1,0 +1,59 @@
+"""Tuned-parameters files: a small TOML file with the matcher and how it was tuned."""
+
+from __future__ import annotations
+
+import os
+import tomllib
+from pathlib import Path
+from typing import Any
+
+from host.errors import HostError
+from host.files import write_text_atomic
+from host.stereo.params import MatcherParams
+
+
+def _toml_value(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, (int, float)):
+        return repr(v)
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    raise TypeError(f"cannot write {type(v).__name__} to TOML")
+
+
+def _table(name: str, data: dict[str, Any]) -> str:
+    lines = [f"[{name}]"] + [f"{k} = {_toml_value(v)}" for k, v in data.items() if v is not None]
+    return "\n".join(lines) + "\n"
+
+
+def save_params(path: str | os.PathLike[str], params: MatcherParams,
+                tuning: dict[str, Any] | None = None) -> None:
+    """Write [matcher] (every parameter) and [tuning] (method, scenes, score ...) atomically."""
+    text = "# stereo-servo matcher parameters (host tune); read by host eval/servo --params\n"
+    text += _table("matcher", params.to_dict())
+    if tuning:
+        text += "\n" + _table("tuning", tuning)
+    write_text_atomic(path, text)
+
+
+def load_params(path: str | os.PathLike[str]) -> tuple[MatcherParams, dict[str, Any]]:
+    """Read a params file; returns the validated matcher parameters and the [tuning] table."""
+    p = Path(path)
+    try:
+        data = tomllib.loads(p.read_text())
+    except OSError as e:
+        raise HostError(f"{p}: cannot read ({e.strerror})") from None
+    except tomllib.TOMLDecodeError as e:
+        raise HostError(f"{p}: not a valid TOML file ({e})") from None
+    if "matcher" not in data:
+        raise HostError(f"{p}: no [matcher] table")
+    try:
+        params = MatcherParams.from_dict(data["matcher"]).validate()
+    except HostError as e:
+        raise HostError(f"{p}: {e}") from None
+    except TypeError as e:
+        raise HostError(f"{p}: bad [matcher] table ({e})") from None
+    return params, data.get("tuning", {})

@@ -1,0 +1,78 @@
+"""compute_disparity: one entry point for every matcher (own SAD/SSD/NCC and OpenCV's)."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from host.errors import HostError
+from host.stereo import block_matching as bm
+from host.stereo.grey import to_grey
+from host.stereo.opencv_backend import opencv_disparity
+from host.stereo.params import MatcherParams
+from host.stereo.postprocess import fill_background, lr_consistency, median
+
+
+def _box_sums(img: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray]:
+    f = img.astype(np.float64)
+    s = cv2.boxFilter(f, cv2.CV_64F, (size, size), normalize=False,
+                      borderType=cv2.BORDER_CONSTANT)
+    sq = cv2.boxFilter(f * f, cv2.CV_64F, (size, size), normalize=False,
+                       borderType=cv2.BORDER_CONSTANT)
+    return s, sq
+
+
+def _planes(image: np.ndarray, colour: bool) -> np.ndarray:
+    """uint8 (channels, rows, cols): BGR planes when colour is asked for and present, else grey."""
+    if colour and image.ndim == 3 and image.shape[2] >= 3 and image.dtype == np.uint8:
+        return np.ascontiguousarray(np.moveaxis(image[:, :, :3], 2, 0))
+    return to_grey(image)[None]
+
+
+def own_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.ndarray:
+    """The paper's block matcher (SAD, or SSD / ZNCC) with WTA, sub-pixel and LR check.
+
+    SAD and SSD sum the cost over the colour channels when p.colour is set; NCC uses grey.
+    """
+    kind = bm.COSTS[p.matcher]
+    colour = p.colour and kind != bm.COST_NCC
+    pl, pr = _planes(left, colour), _planes(right, colour)
+    if kind == bm.COST_NCC:
+        left, right = pl[0], pr[0]
+        sl, ql = _box_sums(left, p.block_size)
+        sr, qr = _box_sums(right, p.block_size)
+    else:
+        sl = ql = sr = qr = np.zeros((1, 1))
+    want_right = p.lr_check is not None
+    disp_l, disp_r = bm.match_rows(pl, pr, p.min_disparity, p.num_disparities,
+                                   p.block_size // 2, kind, float(p.uniqueness_ratio),
+                                   p.subpixel, want_right, p.border == "clip",
+                                   sl, ql, sr, qr)
+    if want_right:
+        disp_l = lr_consistency(disp_l, disp_r, float(p.lr_check))
+    return disp_l
+
+
+def compute_disparity(left: np.ndarray, right: np.ndarray, params: MatcherParams) -> np.ndarray:
+    """Disparity of the left view in px, float32, NaN = invalid. Colour input is converted."""
+    if left.shape[:2] != right.shape[:2]:
+        raise HostError(f"left and right images differ in size: {left.shape[1]}x{left.shape[0]}"
+                        f" vs {right.shape[1]}x{right.shape[0]}")
+    p = params.validate(width=left.shape[1])
+    if p.matcher.startswith("opencv"):
+        disp = opencv_disparity(left, right, p)
+    else:
+        disp = own_disparity(left, right, p)
+    if p.fill:
+        disp = fill_background(disp)
+    if p.median:
+        disp = median(disp, p.median)
+    return disp
+
+
+def warm_up(params: MatcherParams) -> None:
+    """Compile (or load from numba's cache) the kernels params needs, so timings exclude it."""
+    rng = np.random.default_rng(0)
+    size = (24, 48 + params.block_size + params.min_disparity, 3)
+    img = rng.integers(0, 255, size, dtype=np.uint8)
+    compute_disparity(img, img, params.replace(num_disparities=16))

@@ -1,0 +1,102 @@
+"""Matcher parameters: one validated record shared by the matcher, tuner, CLI and params files."""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, fields, replace
+from typing import Any
+
+from host.errors import HostError
+
+MATCHERS = ("sad", "ssd", "ncc", "opencv-bm", "opencv-sgbm")
+BORDERS = ("invalid", "clip")
+SGBM_MODES = {"sgbm": 0, "hh": 1, "sgbm3way": 2, "hh4": 3}
+
+
+@dataclass(frozen=True)
+class MatcherParams:
+    """Block-matching parameters; names follow OpenCV's (blockSize -> block_size ...).
+
+    Units: block_size, num_disparities, min_disparity, lr_check and speckle_range in pixels;
+    uniqueness_ratio in percent (0 = off); lr_check None = off; colour = match on the BGR
+    channels where the input has them (SAD, SSD, SGBM), else on grey; border = "invalid"
+    (a pixel whose window leaves the image has no disparity) or "clip" (the window is cropped
+    to the image; own matchers only); median = median-filter size
+    applied after filling (0 = off); fill = fill invalid pixels from the farther valid neighbour.
+    """
+
+    matcher: str = "sad"
+    block_size: int = 9
+    num_disparities: int = 64
+    min_disparity: int = 0
+    subpixel: bool = True
+    colour: bool = True
+    border: str = "invalid"
+    lr_check: float | None = None
+    uniqueness_ratio: float = 0.0
+    fill: bool = False
+    median: int = 0
+    pre_filter_cap: int = 31
+    texture_threshold: int = 10
+    speckle_window_size: int = 0
+    speckle_range: int = 2
+    p1: int = 0
+    p2: int = 0
+    mode: str = "sgbm"
+
+    def replace(self, **changes: Any) -> "MatcherParams":
+        return replace(self, **changes)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {k: v for k, v in asdict(self).items() if v is not None}
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> "MatcherParams":
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise HostError(f"unknown matcher parameter(s): {', '.join(unknown)}")
+        defaults = cls()
+        for key, value in data.items():
+            want = type(getattr(defaults, key))
+            if key == "lr_check" and (value is None or isinstance(value, (int, float))):
+                continue
+            if want is float and isinstance(value, int) and not isinstance(value, bool):
+                continue
+            if not isinstance(value, want) or (want is int and isinstance(value, bool)):
+                raise HostError(f"matcher parameter {key} must be {want.__name__}, got {value!r}")
+        return cls(**data)
+
+    def validate(self, width: int | None = None) -> "MatcherParams":
+        """Check bounds; width (px) also bounds the disparity range. Returns self."""
+        if self.matcher not in MATCHERS:
+            raise HostError(f"unknown matcher {self.matcher!r} (choose from {', '.join(MATCHERS)})")
+        if self.block_size < 1 or self.block_size % 2 == 0:
+            raise HostError(f"window must be odd and positive, got {self.block_size}")
+        if self.block_size > 255 or (self.matcher == "opencv-bm" and not 5 <= self.block_size):
+            raise HostError(f"window {self.block_size} is out of range for {self.matcher}")
+        if self.num_disparities < 1:
+            raise HostError(f"num-disp must be positive, got {self.num_disparities}")
+        if self.matcher.startswith("opencv") and self.num_disparities % 16:
+            raise HostError(f"{self.matcher} needs num-disp divisible by 16, "
+                            f"got {self.num_disparities}")
+        if self.lr_check is not None and self.lr_check < 0:
+            raise HostError(f"lr-check tolerance must be >= 0 px, got {self.lr_check}")
+        if self.uniqueness_ratio < 0:
+            raise HostError(f"uniqueness ratio must be >= 0, got {self.uniqueness_ratio}")
+        if self.border not in BORDERS:
+            raise HostError(f"unknown border {self.border!r} (choose from {', '.join(BORDERS)})")
+        if not self.matcher.startswith("opencv") and self.min_disparity < 0:
+            raise HostError(f"min-disp must be >= 0 for {self.matcher}, got {self.min_disparity}")
+        if self.median not in (0, 3, 5):
+            raise HostError(f"median must be 0, 3 or 5, got {self.median}")
+        if self.mode not in SGBM_MODES:
+            raise HostError(f"unknown SGBM mode {self.mode!r} (choose from {', '.join(SGBM_MODES)})")
+        if width is not None:
+            if self.block_size >= width:
+                raise HostError(f"window {self.block_size} is too large for an image "
+                                f"{width} px wide")
+            if self.min_disparity + self.num_disparities > width - self.block_size // 2:
+                raise HostError(f"disparity range {self.min_disparity}.."
+                                f"{self.min_disparity + self.num_disparities - 1} is wider "
+                                f"than the image ({width} px)")
+        return self

@@ -1,0 +1,63 @@
+"""Disparity post-processing: left-right consistency, hole filling, median filtering."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def lr_consistency(disp_l: np.ndarray, disp_r: np.ndarray, tol: float) -> np.ndarray:
+    """Invalidate (NaN) left disparities whose right match disagrees by more than tol px."""
+    out = disp_l.copy()
+    h, w = disp_l.shape
+    for y in range(h):
+        for x in range(w):
+            d = disp_l[y, x]
+            if np.isnan(d):
+                continue
+            xr = int(np.floor(x - d + 0.5))
+            if xr < 0 or xr >= w or not abs(disp_r[y, xr] - d) <= tol:
+                out[y, x] = np.nan
+    return out
+
+
+@njit(cache=True)
+def fill_background(disp: np.ndarray) -> np.ndarray:
+    """Fill each invalid run along a row with the smaller (farther) of its two valid ends.
+
+    Occlusions lie beside a depth edge on the background side, so the farther neighbour is the
+    right guess there. Rows with no valid pixel stay NaN.
+    """
+    out = disp.copy()
+    h, w = disp.shape
+    for y in range(h):
+        x = 0
+        while x < w:
+            if not np.isnan(out[y, x]):
+                x += 1
+                continue
+            start = x
+            while x < w and np.isnan(out[y, x]):
+                x += 1
+            left = out[y, start - 1] if start > 0 else np.nan
+            right = out[y, x] if x < w else np.nan
+            if np.isnan(left):
+                value = right
+            elif np.isnan(right):
+                value = left
+            else:
+                value = min(left, right)
+            for i in range(start, x):
+                out[y, i] = value
+    return out
+
+
+def median(disp: np.ndarray, size: int) -> np.ndarray:
+    """Median filter (size 3 or 5) that keeps NaN where the input had no disparity."""
+    invalid = np.isnan(disp)
+    filled = np.where(invalid, 0.0, disp).astype(np.float32)
+    out = cv2.medianBlur(filled, size)
+    out[invalid] = np.nan
+    return out

@@ -1,0 +1,104 @@
+"""host eval / host disparity as a user runs them: exit codes, table, JSON, one-line errors."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from host.cli import main
+from host.stereo.synthetic import synthetic_scene
+
+
+def run(*argv: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "host", *argv], capture_output=True, text=True)
+
+
+@pytest.fixture()
+def pair(tmp_path: Path) -> tuple[Path, Path]:
+    s = synthetic_scene(seed=5, width=160, height=120, max_disp=24)
+    cv2.imwrite(str(tmp_path / "l.png"), s.left)
+    cv2.imwrite(str(tmp_path / "r.png"), s.right)
+    return tmp_path / "l.png", tmp_path / "r.png"
+
+
+def test_disparity_writes_picture_and_raw_map(pair: tuple[Path, Path], tmp_path: Path) -> None:
+    out, npy = tmp_path / "d.png", tmp_path / "d.npy"
+    assert main(["disparity", str(pair[0]), str(pair[1]), "-o", str(out), "--npy", str(npy),
+                 "--num-disp", "32", "--window", "7"]) == 0
+    pic = cv2.imread(str(out))
+    raw = np.load(npy)
+    assert pic.shape == (120, 160, 3) and raw.shape == (120, 160) and raw.dtype == np.float32
+    assert (pic[np.isnan(raw)] == 0).all()
+
+
+def test_eval_json_has_the_documented_keys(middlebury: Path, capsys) -> None:
+    assert main(["eval", str(middlebury / "cones"), "--json", "--border", "clip"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    row = out["scenes"][0]
+    assert set(row) == {"scene", "bad", "bad_nonocc", "rms", "density", "ms"}
+    assert row["scene"] == "cones" and 0 < row["bad_nonocc"] < row["bad"] < 100
+
+
+def test_eval_default_scene_prints_a_table_with_null_nonocc(capsys) -> None:
+    assert main(["eval", "--json"]) == 0
+    row = json.loads(capsys.readouterr().out)["scenes"][0]
+    assert row["scene"] == "motorcycle" and row["bad_nonocc"] is None
+    assert main(["eval", "--window", "11"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[1].split() == ["scene", "bad%", "nonocc%", "rms", "density%", "ms"]
+    assert lines[2].split()[0] == "motorcycle" and lines[2].split()[2] == "-"
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--window", "8"], "window must be odd"),
+    (["--window", "301"], "out of range"),
+    (["--num-disp", "900"], "wider than the image"),
+    (["--matcher", "opencv-bm", "--num-disp", "40"], "divisible by 16"),
+])
+def test_bad_matcher_options_are_one_line_errors(pair: tuple[Path, Path], tmp_path: Path,
+                                                 argv: list[str], message: str) -> None:
+    r = run("disparity", str(pair[0]), str(pair[1]), "-o", str(tmp_path / "o.png"), *argv)
+    assert r.returncode == 2
+    assert r.stderr.count("\n") == 1 and message in r.stderr and "Traceback" not in r.stderr
+    assert not (tmp_path / "o.png").exists()
+
+
+def test_missing_and_mismatched_images(pair: tuple[Path, Path], tmp_path: Path) -> None:
+    r = run("disparity", str(tmp_path / "none.png"), str(pair[1]), "-o", str(tmp_path / "o.png"))
+    assert r.returncode == 2 and "none.png: no such file" in r.stderr
+    small = tmp_path / "small.png"
+    cv2.imwrite(str(small), np.zeros((50, 60), np.uint8))
+    r = run("disparity", str(pair[0]), str(small), "-o", str(tmp_path / "o.png"))
+    assert r.returncode == 2 and "differ in size" in r.stderr
+    (tmp_path / "junk.png").write_bytes(b"not an image")
+    r = run("disparity", str(tmp_path / "junk.png"), str(pair[1]), "-o", str(tmp_path / "o.png"))
+    assert r.returncode == 2 and "not a readable image" in r.stderr
+
+
+def test_eval_refuses_a_scene_without_ground_truth(tmp_path: Path) -> None:
+    for name in ("im0.png", "im1.png"):
+        cv2.imwrite(str(tmp_path / name), np.zeros((40, 60), np.uint8))
+    r = run("eval", str(tmp_path))
+    assert r.returncode == 2 and "no ground truth" in r.stderr
+
+
+def test_params_file_feeds_eval(tmp_path: Path, capsys) -> None:
+    from host.params_file import load_params, save_params
+    from host.stereo import MatcherParams
+
+    path = tmp_path / "p.toml"
+    save_params(path, MatcherParams(matcher="ncc", block_size=7, lr_check=1.0),
+                {"method": "grid", "scenes": ["x"]})
+    params, tuning = load_params(path)
+    assert params.matcher == "ncc" and params.lr_check == 1.0 and tuning["method"] == "grid"
+    assert main(["eval", "--params", str(path), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["matcher"]["block_size"] == 7
+    path.write_text("[matcher]\nblock_size = 'x'\n")
+    assert main(["eval", "--params", str(path)]) == 2
