@@ -10,7 +10,7 @@ DATA ?= $(abspath ../shared/data)
 # tests and benchmarks find the Middlebury scenes through this variable
 export STEREO_SERVO_DATA ?= $(if $(wildcard $(DATA)/middlebury/index.json),$(DATA),)
 
-.PHONY: demo test bench venv system-deps clean
+.PHONY: demo test bench venv system-deps protocol clean
 
 $(BIN)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -33,6 +33,11 @@ test: venv system-deps
 
 bench: venv
 	$(BIN)/python bench/matcher.py
+	$(BIN)/python bench/protocol.py
+
+# regenerate everything derived from protocol/spec.toml (tests fail while it is stale)
+protocol: venv
+	$(BIN)/python tools/protogen.py
 
 clean:
 	rm -rf $(VENV) $(OUT) .pytest_cache

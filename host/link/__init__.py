@@ -1,0 +1,1 @@
+"""The serial link: protocol framing and messages, and the client that drives the robot."""
