@@ -10,7 +10,7 @@ DATA ?= $(abspath ../shared/data)
 # tests and benchmarks find the Middlebury scenes through this variable
 export STEREO_SERVO_DATA ?= $(if $(wildcard $(DATA)/middlebury/index.json),$(DATA),)
 
-.PHONY: demo test bench venv system-deps protocol clean
+.PHONY: demo test bench venv system-deps protocol firmware flash clean
 
 $(BIN)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -34,10 +34,18 @@ test: venv system-deps
 bench: venv
 	$(BIN)/python bench/matcher.py
 	$(BIN)/python bench/protocol.py
+	$(BIN)/python bench/firmware.py
 
 # regenerate everything derived from protocol/spec.toml (tests fail while it is stale)
 protocol: venv
 	$(BIN)/python tools/protogen.py
+
+# the robot's firmware (firmware/atmega328/Makefile); flash with PORT=/dev/ttyACM0
+firmware: system-deps
+	$(MAKE) -C firmware/atmega328
+
+flash: system-deps
+	$(MAKE) -C firmware/atmega328 flash
 
 clean:
 	rm -rf $(VENV) $(OUT) .pytest_cache

@@ -11,6 +11,7 @@ void frame_parser_init(struct frame_parser *p)
     p->crc_errors = 0;
     p->framing_errors = 0;
     p->last_seq = 0;
+    p->last_id = 0;
 }
 
 static uint16_t crc_of(const uint8_t *data, uint8_t n)
@@ -51,6 +52,7 @@ static uint8_t step(struct frame_parser *p, uint8_t byte, frame_handler handler,
         if (crc_of(p->buf, n) != crc) {
             p->crc_errors++;
             p->last_seq = p->buf[1];
+            p->last_id = p->buf[2];
             return 1;
         }
         p->good_frames++;

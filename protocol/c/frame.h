@@ -31,7 +31,8 @@ struct frame_parser {
     uint16_t good_frames;
     uint16_t crc_errors;
     uint16_t framing_errors;
-    uint8_t last_seq;     /* SEQ of the last frame rejected for its CRC, for a NACK */
+    uint8_t last_seq;     /* SEQ and ID of the last frame rejected for its CRC, for a NACK */
+    uint8_t last_id;
 };
 
 void frame_parser_init(struct frame_parser *p);

@@ -1,0 +1,28 @@
+/* Timer0 in CTC mode interrupts at 1 kHz: F_CPU / 64 / (OCR0A + 1) = 16 MHz / 64 / 250. */
+#include "clock.h"
+
+#include <avr/interrupt.h>
+#include <avr/io.h>
+#include <util/atomic.h>
+
+static volatile uint32_t ms;
+
+void clock_init(void)
+{
+    TCCR0A = _BV(WGM01);
+    OCR0A = (uint8_t)(F_CPU / 64 / 1000 - 1);
+    TCCR0B = _BV(CS01) | _BV(CS00);
+    TIMSK0 = _BV(OCIE0A);
+}
+
+ISR(TIMER0_COMPA_vect)
+{
+    ms++;
+}
+
+uint32_t clock_ms(void)
+{
+    uint32_t now;
+    ATOMIC_BLOCK(ATOMIC_RESTORESTATE) { now = ms; }
+    return now;
+}

@@ -1,0 +1,23 @@
+/* Drive state: commanded and applied duty of both motors, with the acceleration limit. */
+#ifndef DRIVE_H
+#define DRIVE_H
+
+#include <stdint.h>
+
+enum { DRIVE_LEFT, DRIVE_RIGHT };
+
+struct drive {
+    int16_t target[2];   /* commanded duty, permille */
+    int16_t applied[2];  /* duty applied to the motors now, permille */
+    uint16_t accel_limit; /* largest change per 100 ms, permille; 0 = none */
+    uint16_t budget;     /* accel_limit * elapsed ms not yet spent, in 1/100 permille */
+};
+
+void drive_init(struct drive *d);
+void drive_command(struct drive *d, int16_t left, int16_t right);
+void drive_stop(struct drive *d);
+/* Move the applied duty towards the target for elapsed_ms; returns 1 when it changed. */
+uint8_t drive_tick(struct drive *d, uint16_t elapsed_ms);
+uint8_t drive_ramping(const struct drive *d);
+
+#endif

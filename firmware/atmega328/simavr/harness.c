@@ -1,0 +1,266 @@
+/* Runs the real firmware ELF in simavr (ATmega328P, 16 MHz) and shows what its pins do.
+ *
+ *   harness FIRMWARE.elf           scripted, as fast as it can: commands on stdin
+ *   harness FIRMWARE.elf --pty     real time, UART0 bridged to a pseudo-terminal
+ *
+ * Scripted commands, one a line:
+ *   send HEX     queue bytes for UART0, delivered at 115200 baud once the UART says XON
+ *   run MS       simulate MS milliseconds
+ *   quiet 0|1    stop or start printing each "in" byte (counts are kept either way)
+ * Events on stdout, times in CPU cycles since power-on:
+ *   in CYCLE BYTE              a byte entered UART0 (its start bit)
+ *   tx CYCLE BYTE              UART0 sent a byte
+ *   pwm CYCLE OCR1A OCR1B DIR  a motor output changed (DIR = PD4..PD7 as a 4-bit number)
+ *   reset CYCLE                the chip reset (the watchdog, in these tests)
+ *   end CYCLE INS IN TX RESETS SECONDS   at the end of input
+ * In --pty mode the first line is "pty PATH"; events follow, the in/tx lines left out. */
+#define _GNU_SOURCE
+#include <fcntl.h>
+#include <poll.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <termios.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <simavr/avr_uart.h>
+#include <simavr/sim_avr.h>
+#include <simavr/sim_elf.h>
+
+#define F_CPU 16000000UL
+#define CYCLES_PER_BYTE (10UL * F_CPU / 115200) /* the host's line: 10 bits a byte */
+
+/* ATmega328P data-space addresses (datasheet, register summary) */
+#define REG_PORTD 0x2B
+#define REG_OCR1AL 0x88
+#define REG_OCR1AH 0x89
+#define REG_OCR1BL 0x8A
+#define REG_OCR1BH 0x8B
+#define DIR_SHIFT 4 /* PD4..PD7: IN1 IN2 IN3 IN4 */
+
+static struct {
+    avr_t *avr;
+    avr_irq_t *uart_in;
+    int xon;
+    uint8_t *queue; /* bytes waiting for UART0: queue[q_head..q_tail) */
+    size_t q_head, q_tail, q_cap;
+    avr_cycle_count_t next_in;
+    int quiet, pty_fd;
+    unsigned long n_in, n_tx, resets;
+    unsigned last_a, last_b, last_dir;
+} h;
+
+static void on_tx(struct avr_irq_t *irq, uint32_t value, void *param)
+{
+    (void)irq, (void)param;
+    uint8_t byte = (uint8_t)value;
+    h.n_tx++;
+    if (h.pty_fd >= 0) {
+        if (write(h.pty_fd, &byte, 1) < 0) { /* no reader yet: the byte is lost, as on a wire */ }
+    } else {
+        printf("tx %llu %02x\n", (unsigned long long)h.avr->cycle, byte);
+    }
+}
+
+static void on_xon(struct avr_irq_t *irq, uint32_t value, void *param)
+{
+    (void)irq, (void)value, (void)param;
+    h.xon = 1;
+}
+
+static void on_xoff(struct avr_irq_t *irq, uint32_t value, void *param)
+{
+    (void)irq, (void)value, (void)param;
+    h.xon = 0;
+}
+
+static void no_sleep(avr_t *avr, avr_cycle_count_t how_long)
+{
+    (void)avr, (void)how_long; /* scripted mode runs as fast as it can */
+}
+
+static void feed_uart(void)
+{
+    if (h.q_head == h.q_tail || !h.xon || h.avr->cycle < h.next_in)
+        return;
+    uint8_t byte = h.queue[h.q_head++];
+    h.n_in++;
+    if (h.pty_fd < 0 && !h.quiet)
+        printf("in %llu %02x\n", (unsigned long long)h.avr->cycle, byte);
+    h.next_in = h.avr->cycle + CYCLES_PER_BYTE;
+    avr_raise_irq(h.uart_in, byte);
+}
+
+static void watch_pins(void)
+{
+    const uint8_t *d = h.avr->data;
+    unsigned a = d[REG_OCR1AL] | d[REG_OCR1AH] << 8, b = d[REG_OCR1BL] | d[REG_OCR1BH] << 8;
+    unsigned dir = (d[REG_PORTD] >> DIR_SHIFT) & 0x0F;
+    if (a == h.last_a && b == h.last_b && dir == h.last_dir)
+        return;
+    h.last_a = a, h.last_b = b, h.last_dir = dir;
+    printf("pwm %llu %u %u %u\n", (unsigned long long)h.avr->cycle, a, b, dir);
+}
+
+static int step(void)
+{
+    avr_flashaddr_t pc = h.avr->pc;
+    int state = avr_run(h.avr);
+    if (state == cpu_Done || state == cpu_Crashed) {
+        printf("crashed %llu state %d\n", (unsigned long long)h.avr->cycle, state);
+        return -1;
+    }
+    if (h.avr->pc == 0 && pc != 0) {
+        h.resets++;
+        h.xon = 0; /* hold bytes until the reset firmware enables its UART again */
+        printf("reset %llu\n", (unsigned long long)h.avr->cycle);
+    }
+    feed_uart();
+    watch_pins();
+    return 0;
+}
+
+static int run_until(avr_cycle_count_t end)
+{
+    while (h.avr->cycle < end)
+        if (step() < 0)
+            return -1;
+    return 0;
+}
+
+static void queue_byte(uint8_t byte)
+{
+    if (h.q_head == h.q_tail)
+        h.q_head = h.q_tail = 0;
+    if (h.q_tail == h.q_cap) {
+        h.q_cap = h.q_cap ? 2 * h.q_cap : 4096;
+        h.queue = realloc(h.queue, h.q_cap);
+        if (!h.queue) {
+            perror("harness");
+            exit(1);
+        }
+    }
+    h.queue[h.q_tail++] = byte;
+}
+
+static void queue_hex(const char *hex)
+{
+    for (; hex[0] && hex[1]; hex += 2) {
+        unsigned v;
+        if (sscanf(hex, "%2x", &v) != 1)
+            break;
+        queue_byte((uint8_t)v);
+    }
+}
+
+static double wall(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return t.tv_sec + t.tv_nsec * 1e-9;
+}
+
+static int scripted(void)
+{
+    char *line = NULL;
+    size_t cap = 0;
+    double t0 = wall();
+    while (getline(&line, &cap, stdin) > 0) {
+        char cmd[16];
+        double arg = 0;
+        if (sscanf(line, "%15s", cmd) != 1)
+            continue;
+        if (!strcmp(cmd, "send"))
+            queue_hex(line + 5);
+        else if (!strcmp(cmd, "quiet") && sscanf(line + 6, "%lf", &arg) == 1)
+            h.quiet = arg != 0;
+        else if (!strcmp(cmd, "run") && sscanf(line + 4, "%lf", &arg) == 1) {
+            if (run_until(h.avr->cycle + (avr_cycle_count_t)(arg * F_CPU / 1000)) < 0)
+                return 1;
+        } else {
+            fprintf(stderr, "harness: unknown command: %.40s\n", line);
+            return 2;
+        }
+        fflush(stdout);
+    }
+    free(line);
+    printf("end %llu %llu %lu %lu %lu %.3f\n", (unsigned long long)h.avr->cycle,
+           (unsigned long long)h.avr->cycle, h.n_in, h.n_tx, h.resets, wall() - t0);
+    return 0;
+}
+
+static int open_pty(void)
+{
+    int master = posix_openpt(O_RDWR | O_NOCTTY);
+    if (master < 0 || grantpt(master) < 0 || unlockpt(master) < 0)
+        return -1;
+    const char *name = ptsname(master);
+    int slave = open(name, O_RDWR | O_NOCTTY); /* held open: clients may come and go */
+    struct termios tio;
+    tcgetattr(slave, &tio);
+    cfmakeraw(&tio);
+    tcsetattr(slave, TCSANOW, &tio);
+    fcntl(master, F_SETFL, O_NONBLOCK);
+    printf("pty %s\n", name);
+    fflush(stdout);
+    return master;
+}
+
+static int real_time(void)
+{
+    h.pty_fd = open_pty();
+    if (h.pty_fd < 0) {
+        perror("harness: pty");
+        return 1;
+    }
+    double t0 = wall();
+    for (;;) {
+        /* one simulated millisecond, then wait for the wall clock to catch up */
+        if (run_until(h.avr->cycle + F_CPU / 1000) < 0)
+            return 1;
+        uint8_t buf[256];
+        ssize_t n;
+        while ((n = read(h.pty_fd, buf, sizeof buf)) > 0)
+            for (ssize_t i = 0; i < n; i++)
+                queue_byte(buf[i]);
+        fflush(stdout);
+        double ahead = (double)h.avr->cycle / F_CPU - (wall() - t0);
+        if (ahead > 0)
+            usleep((useconds_t)(ahead * 1e6));
+    }
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        fprintf(stderr, "usage: harness FIRMWARE.elf [--pty]\n");
+        return 2;
+    }
+    elf_firmware_t fw;
+    memset(&fw, 0, sizeof fw);
+    if (elf_read_firmware(argv[1], &fw) != 0) {
+        fprintf(stderr, "harness: cannot read %s\n", argv[1]);
+        return 2;
+    }
+    h.avr = avr_make_mcu_by_name("atmega328p");
+    avr_init(h.avr);
+    avr_load_firmware(h.avr, &fw);
+    h.avr->frequency = F_CPU;
+    h.pty_fd = -1;
+    h.last_a = h.last_b = h.last_dir = ~0u; /* the first step prints the outputs at power-on */
+    uint32_t flags = 0; /* no console echo of UART output */
+    avr_ioctl(h.avr, AVR_IOCTL_UART_SET_FLAGS('0'), &flags);
+    h.uart_in = avr_io_getirq(h.avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_INPUT);
+    avr_irq_register_notify(avr_io_getirq(h.avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUTPUT),
+                            on_tx, NULL);
+    avr_irq_register_notify(avr_io_getirq(h.avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUT_XON),
+                            on_xon, NULL);
+    avr_irq_register_notify(avr_io_getirq(h.avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUT_XOFF),
+                            on_xoff, NULL);
+    int pty = argc > 2 && !strcmp(argv[2], "--pty");
+    if (!pty)
+        h.avr->sleep = no_sleep;
+    setvbuf(stdout, NULL, _IOFBF, 1 << 16);
+    return pty ? real_time() : scripted();
+}

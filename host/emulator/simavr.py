@@ -1,0 +1,105 @@
+"""Run the real firmware ELF under simavr (firmware/atmega328/simavr/harness.c) from a script,
+and read back what its pins and UART did, in simulated CPU cycles."""
+
+from __future__ import annotations
+
+import subprocess
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from host.link.frame import Frame, FrameDecoder, encode_frame
+from host.link.messages import pack
+
+F_CPU = 16_000_000
+CYCLES_PER_BYTE = 10 * F_CPU // 115200  # the harness feeds bytes at the host's line rate
+
+
+@dataclass
+class Pwm:
+    cycle: int
+    ocr1a: int
+    ocr1b: int
+    dir: int  # PD4..PD7 = IN1 IN2 IN3 IN4 as bits 0..3
+
+
+@dataclass
+class SimRun:
+    ins: list[tuple[int, int]] = field(default_factory=list)   # (cycle, byte) into the UART
+    tx: list[tuple[int, int]] = field(default_factory=list)    # (cycle, byte) out of the UART
+    pwm: list[Pwm] = field(default_factory=list)
+    resets: list[int] = field(default_factory=list)
+    end_cycle: int = 0
+    seconds: float = 0.0
+    n_in: int = 0
+    n_tx: int = 0
+
+    def frames(self) -> list[Frame]:
+        return FrameDecoder().feed(bytes(b for _, b in self.tx))
+
+    def frames_with_cycles(self) -> list[tuple[int, Frame]]:
+        dec, out = FrameDecoder(), []
+        for cycle, b in self.tx:
+            out += [(cycle, f) for f in dec.feed(bytes([b]))]
+        return out
+
+    def settled(self) -> list[Pwm]:
+        """Output changes with the transients dropped: the firmware writes OCR1A, then OCR1B a
+        few cycles later; a state that lasted under 100 cycles is not a state."""
+        out = []
+        for p, nxt in zip(self.pwm, self.pwm[1:] + [None]):
+            if nxt is None or nxt.cycle - p.cycle >= 100:
+                out.append(p)
+        return out
+
+    def last_in_done(self) -> int:
+        """Cycle at which the last byte sent had fully arrived (its stop bit)."""
+        return self.ins[-1][0] + CYCLES_PER_BYTE
+
+
+class Script:
+    """Commands for the harness: send bytes, let simulated time pass."""
+
+    def __init__(self) -> None:
+        self.lines: list[str] = []
+
+    def send(self, data: bytes) -> "Script":
+        self.lines.append(f"send {data.hex()}")
+        return self
+
+    def message(self, seq: int, msg) -> "Script":
+        return self.send(encode_frame(seq, *pack(msg)))
+
+    def run_ms(self, ms: float) -> "Script":
+        self.lines.append(f"run {ms}")
+        return self
+
+    def quiet(self, on: bool = True) -> "Script":
+        self.lines.append(f"quiet {int(on)}")
+        return self
+
+    def text(self) -> str:
+        return "\n".join(self.lines) + "\n"
+
+
+def run(harness: Path, elf: Path, script: Script, timeout: float = 120) -> SimRun:
+    out = subprocess.run([str(harness), str(elf)], input=script.text(), capture_output=True,
+                         text=True, timeout=timeout)
+    if out.returncode:
+        raise RuntimeError(f"harness failed ({out.returncode}): {out.stderr}{out.stdout[-500:]}")
+    r = SimRun()
+    for line in out.stdout.splitlines():
+        kind, *rest = line.split()
+        if kind == "in":
+            r.ins.append((int(rest[0]), int(rest[1], 16)))
+        elif kind == "tx":
+            r.tx.append((int(rest[0]), int(rest[1], 16)))
+        elif kind == "pwm":
+            r.pwm.append(Pwm(*map(int, rest)))
+        elif kind == "reset":
+            r.resets.append(int(rest[0]))
+        elif kind == "end":
+            r.end_cycle, r.n_in, r.n_tx = int(rest[0]), int(rest[2]), int(rest[3])
+            r.seconds = float(rest[5])
+        elif kind == "crashed":
+            raise RuntimeError(f"firmware crashed: {line}")
+    return r
