@@ -35,6 +35,7 @@ bench: venv
 	$(BIN)/python bench/matcher.py
 	$(BIN)/python bench/protocol.py
 	$(BIN)/python bench/firmware.py
+	$(BIN)/python bench/link.py
 
 # regenerate everything derived from protocol/spec.toml (tests fail while it is stale)
 protocol: venv

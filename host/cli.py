@@ -5,10 +5,10 @@ from __future__ import annotations
 import argparse
 import sys
 
-from host.commands import disparity, eval as eval_cmd
+from host.commands import disparity, emulate, eval as eval_cmd
 from host.errors import HostError
 
-COMMANDS = [eval_cmd, disparity]
+COMMANDS = [eval_cmd, disparity, emulate]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -322,7 +322,8 @@ def render_docs(spec: Spec) -> str:
            " every command with ACK or NACK carrying its SEQ, except HELLO (HELLO_REPLY) and"
            " GET_STATUS (STATUS). A command with the same SEQ and ID as the last one applied is"
            " acknowledged again (ACK result DUPLICATE) and not applied twice, so the host may"
-           " resend freely.",
+           " resend freely; HELLO starts a new session and a link-loss stop ends the old"
+           " stream, so after either the next command is applied whatever its SEQ.",
            f"- CRC is {p['crc']} (poly 0x1021, init 0xFFFF, no reflection, no final XOR) over LEN,"
            " SEQ, ID and PAYLOAD, sent low byte first. On the AVR: `_crc_xmodem_update` from"
            " `<util/crc16.h>` starting at 0xFFFF; on the host: crcmod's `crc-ccitt-false`.",

@@ -103,3 +103,29 @@ def run(harness: Path, elf: Path, script: Script, timeout: float = 120) -> SimRu
         elif kind == "crashed":
             raise RuntimeError(f"firmware crashed: {line}")
     return r
+
+
+class SimavrPty:
+    """The real ELF in simavr, in real time, its UART0 on a pseudo-terminal."""
+
+    def __init__(self, harness: Path, elf: Path) -> None:
+        self._proc = subprocess.Popen([str(harness), str(elf), "--pty"], stdout=subprocess.PIPE,
+                                      stderr=subprocess.DEVNULL, text=True)
+        assert self._proc.stdout is not None
+        for line in self._proc.stdout:  # simavr's own "Loaded ..." lines come first
+            if line.startswith("pty "):
+                self.path = line.split()[1]
+                return
+        self.close()
+        raise RuntimeError("the simavr harness did not start")
+
+    def close(self) -> None:
+        if self._proc.poll() is None:
+            self._proc.terminate()
+            self._proc.wait(timeout=5)
+
+    def __enter__(self) -> "SimavrPty":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

@@ -43,7 +43,7 @@ class AckResult(enum.IntEnum):
     """What an acknowledged command did (ACK.result)."""
 
     APPLIED = 0  # the command was applied
-    DUPLICATE = 1  # same SEQ as the last command: acknowledged again, not applied twice
+    DUPLICATE = 1  # same SEQ and ID as the last command: acknowledged again, not applied twice (unless a link-loss stop came in between: then it is applied)
 
 
 class StatusFlag(enum.IntFlag):

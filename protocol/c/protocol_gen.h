@@ -39,7 +39,7 @@ enum proto_reset_cause {
 /* What an acknowledged command did (ACK.result). */
 enum proto_ack_result {
     PROTO_ACK_RESULT_APPLIED = 0, /* the command was applied */
-    PROTO_ACK_RESULT_DUPLICATE = 1, /* same SEQ as the last command: acknowledged again, not applied twice */
+    PROTO_ACK_RESULT_DUPLICATE = 1, /* same SEQ and ID as the last command: acknowledged again, not applied twice (unless a link-loss stop came in between: then it is applied) */
 };
 
 /* STATUS.flags bits. */

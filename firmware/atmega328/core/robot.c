@@ -145,14 +145,17 @@ static void on_frame(void *ctx, const struct frame *f)
         send_nack(f->seq, error);
         return;
     }
-    if (robot.have_last && f->seq == robot.last_seq && f->id == robot.last_id &&
-        f->id != PROTO_MSG_HELLO && f->id != PROTO_MSG_GET_STATUS) {
-        send_ack(f->seq, PROTO_ACK_RESULT_DUPLICATE); /* a resend: do not apply twice */
-        return;
+    if (f->id == PROTO_MSG_HELLO) {
+        robot.have_last = 0; /* a new session numbers its commands afresh */
+    } else if (f->id != PROTO_MSG_GET_STATUS) {
+        if (robot.have_last && f->seq == robot.last_seq && f->id == robot.last_id) {
+            send_ack(f->seq, PROTO_ACK_RESULT_DUPLICATE); /* a resend: do not apply twice */
+            return;
+        }
+        robot.have_last = 1;
+        robot.last_seq = f->seq;
+        robot.last_id = f->id;
     }
-    robot.have_last = 1;
-    robot.last_seq = f->seq;
-    robot.last_id = f->id;
     dispatch(f);
 }
 
@@ -188,6 +191,7 @@ void robot_tick(uint32_t now_ms)
     robot.last_tick_ms = now_ms;
     if (robot.driving && link_expired(&robot.link, now_ms)) {
         robot.link.lost = 1;
+        robot.have_last = 0; /* a resend after this stop is applied again, not a duplicate */
         stop();
         return;
     }

@@ -13,7 +13,7 @@
  *   pwm CYCLE OCR1A OCR1B DIR  a motor output changed (DIR = PD4..PD7 as a 4-bit number)
  *   reset CYCLE                the chip reset (the watchdog, in these tests)
  *   end CYCLE INS IN TX RESETS SECONDS   at the end of input
- * In --pty mode the first line is "pty PATH"; events follow, the in/tx lines left out. */
+ * In --pty mode stdout has the one line "pty PATH"; the pwm and reset events go to stderr. */
 #define _GNU_SOURCE
 #include <fcntl.h>
 #include <poll.h>
@@ -47,6 +47,7 @@ static struct {
     size_t q_head, q_tail, q_cap;
     avr_cycle_count_t next_in;
     int quiet, pty_fd;
+    FILE *events; /* pwm and reset lines */
     unsigned long n_in, n_tx, resets;
     unsigned last_a, last_b, last_dir;
 } h;
@@ -100,7 +101,7 @@ static void watch_pins(void)
     if (a == h.last_a && b == h.last_b && dir == h.last_dir)
         return;
     h.last_a = a, h.last_b = b, h.last_dir = dir;
-    printf("pwm %llu %u %u %u\n", (unsigned long long)h.avr->cycle, a, b, dir);
+    fprintf(h.events, "pwm %llu %u %u %u\n", (unsigned long long)h.avr->cycle, a, b, dir);
 }
 
 static int step(void)
@@ -114,7 +115,7 @@ static int step(void)
     if (h.avr->pc == 0 && pc != 0) {
         h.resets++;
         h.xon = 0; /* hold bytes until the reset firmware enables its UART again */
-        printf("reset %llu\n", (unsigned long long)h.avr->cycle);
+        fprintf(h.events, "reset %llu\n", (unsigned long long)h.avr->cycle);
     }
     feed_uart();
     watch_pins();
@@ -259,6 +260,7 @@ int main(int argc, char **argv)
     avr_irq_register_notify(avr_io_getirq(h.avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUT_XOFF),
                             on_xoff, NULL);
     int pty = argc > 2 && !strcmp(argv[2], "--pty");
+    h.events = pty ? stderr : stdout;
     if (!pty)
         h.avr->sleep = no_sleep;
     setvbuf(stdout, NULL, _IOFBF, 1 << 16);

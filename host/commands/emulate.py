@@ -1,0 +1,80 @@
+"""host emulate: the robot on a pseudo-terminal, for `host servo --port PATH` or any serial tool."""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from host.emulator.emulator import Emulator, Faults, PtyService
+from host.errors import HostError
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("emulate", help="run the robot's firmware on a pseudo-terminal")
+    p.add_argument("--simavr", action="store_true",
+                   help="run the real AVR binary in simavr instead of the natively built core")
+    p.add_argument("--drop", type=float, default=0.0, metavar="RATE",
+                   help="drop this share of the bytes, both ways")
+    p.add_argument("--corrupt", type=float, default=0.0, metavar="RATE",
+                   help="corrupt this share of the bytes, both ways")
+    p.add_argument("--delay-ms", type=float, default=0.0, help="delay every byte (ms)")
+    p.add_argument("--silent-after", type=float, metavar="S",
+                   help="stop answering (cut the line) after S seconds")
+    p.add_argument("--seed", type=int, default=0, help="seed of the fault injection")
+    p.add_argument("--duration", type=float, metavar="S", help="stop after S seconds")
+    p.set_defaults(run=run)
+
+
+def _check_rate(name: str, value: float) -> None:
+    if not 0.0 <= value < 1.0:
+        raise HostError(f"--{name} must be in [0, 1), got {value}")
+
+
+def run(args: argparse.Namespace) -> int:
+    _check_rate("drop", args.drop)
+    _check_rate("corrupt", args.corrupt)
+    signal.signal(signal.SIGTERM, lambda *_: (_ for _ in ()).throw(KeyboardInterrupt))
+    if args.simavr:
+        return _run_simavr(args)
+    faults = Faults(args.drop, args.corrupt, args.delay_ms,
+                    None if args.silent_after is None else args.silent_after * 1000, args.seed)
+    emu = Emulator(faults)
+    with PtyService(emu) as service:
+        print(service.path, flush=True)
+        print(f"emulating the robot on {service.path} (Ctrl-C to stop)", file=sys.stderr)
+        last = None
+        t_end = None if args.duration is None else time.monotonic() + args.duration
+        try:
+            while t_end is None or time.monotonic() < t_end:
+                motors = emu.motors()
+                if motors != last:
+                    print(f"t={emu.now_ms / 1000:8.3f} s  motors left {motors[0]:5d} "
+                          f"right {motors[1]:5d} permille", file=sys.stderr, flush=True)
+                    last = motors
+                time.sleep(0.01)
+        except KeyboardInterrupt:
+            pass
+    return 0
+
+
+def _run_simavr(args: argparse.Namespace) -> int:
+    from host.emulator import build
+    from host.emulator.simavr import SimavrPty
+
+    if args.drop or args.corrupt or args.delay_ms or args.silent_after is not None:
+        raise HostError("fault injection works on the native emulator only (drop --simavr)")
+    with tempfile.TemporaryDirectory() as d:
+        harness = build.simavr_harness(Path(d))
+        with SimavrPty(harness, build.firmware_elf()) as sim:
+            print(sim.path, flush=True)
+            print(f"the firmware ELF runs in simavr on {sim.path} (Ctrl-C to stop)",
+                  file=sys.stderr)
+            try:
+                time.sleep(args.duration if args.duration is not None else 1e9)
+            except KeyboardInterrupt:
+                pass
+    return 0

@@ -1,0 +1,81 @@
+"""The firmware's own register-free C core (firmware/atmega328/core) built natively as a shared
+library and driven through ctypes: the emulator runs the same code as the robot, not a model."""
+
+from __future__ import annotations
+
+import ctypes
+import hashlib
+import os
+import shutil
+import subprocess
+import tempfile
+from pathlib import Path
+
+from host.emulator.build import FIRMWARE, ROOT
+from host.errors import HostError
+
+SOURCES = [FIRMWARE / "core" / "robot.c", FIRMWARE / "core" / "drive.c",
+           FIRMWARE / "core" / "link.c", FIRMWARE / "emu" / "board.c",
+           ROOT / "protocol" / "c" / "frame.c"]
+HEADERS = sorted((FIRMWARE / "core").glob("*.h")) + sorted((ROOT / "protocol" / "c").glob("*.h")) + [
+    FIRMWARE / "config.h"]
+CACHE = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "stereo-servo"
+
+
+def build_library() -> Path:
+    """Compile the core into a shared library, cached by a hash of its sources."""
+    missing = [p for p in SOURCES if not p.exists()]
+    if missing:
+        raise HostError(f"firmware sources not found ({missing[0]}): run from a source checkout")
+    if shutil.which("gcc") is None:
+        raise HostError("gcc not found: the emulator compiles the firmware core natively")
+    digest = hashlib.sha256(b"".join(p.read_bytes() for p in SOURCES + HEADERS)).hexdigest()[:16]
+    lib = CACHE / f"firmware-core-{digest}.so"
+    if lib.exists():
+        return lib
+    CACHE.mkdir(parents=True, exist_ok=True)
+    tmp = lib.with_suffix(f".{os.getpid()}.tmp")
+    cmd = ["gcc", "-std=gnu11", "-O2", "-shared", "-fPIC", "-Wall", "-Wextra", "-Werror",
+           f"-I{ROOT / 'protocol' / 'c'}", *map(str, SOURCES), "-o", str(tmp)]
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode:
+        raise HostError(f"building the firmware core failed: {r.stderr.strip()[:300]}")
+    os.replace(tmp, lib)
+    return lib
+
+
+class FirmwareCore:
+    """One robot: the core's state lives in the library's statics, so each instance loads its
+    own copy of the library."""
+
+    def __init__(self, reset_cause: int, now_ms: int = 0) -> None:
+        self._dir = tempfile.TemporaryDirectory(prefix="stereo-servo-core-")
+        path = Path(self._dir.name) / "core.so"
+        shutil.copyfile(build_library(), path)
+        self._lib = ctypes.CDLL(str(path))
+        self._lib.robot_init.argtypes = [ctypes.c_uint8, ctypes.c_uint32]
+        self._lib.robot_rx_byte.argtypes = [ctypes.c_uint8, ctypes.c_uint32]
+        self._lib.robot_tick.argtypes = [ctypes.c_uint32]
+        self._lib.emu_take_tx.argtypes = [ctypes.c_char_p, ctypes.c_uint16]
+        self._lib.emu_take_tx.restype = ctypes.c_uint16
+        self._lib.emu_motors.argtypes = [ctypes.POINTER(ctypes.c_int16)] * 2
+        self._lib.emu_motors.restype = ctypes.c_uint32
+        self._buf = ctypes.create_string_buffer(4096)
+        self._lib.robot_init(reset_cause, now_ms)
+
+    def rx(self, data: bytes, now_ms: int) -> None:
+        for b in data:
+            self._lib.robot_rx_byte(b, now_ms & 0xFFFFFFFF)
+
+    def tick(self, now_ms: int) -> None:
+        self._lib.robot_tick(now_ms & 0xFFFFFFFF)
+
+    def take_tx(self) -> bytes:
+        n = self._lib.emu_take_tx(self._buf, len(self._buf))
+        return self._buf.raw[:n]
+
+    def motors(self) -> tuple[int, int]:
+        """Applied duty (permille) of the left and right motor."""
+        left, right = ctypes.c_int16(), ctypes.c_int16()
+        self._lib.emu_motors(ctypes.byref(left), ctypes.byref(right))
+        return left.value, right.value

@@ -1,0 +1,186 @@
+"""The robot on a PC: the firmware's core with a simulated clock, a 115200-baud line, link
+faults, and a pseudo-terminal that any serial program can open as if it were the robot."""
+
+from __future__ import annotations
+
+import os
+import random
+import select
+import threading
+import time
+import tty
+from collections import deque
+from dataclasses import dataclass
+
+from host.emulator.core import FirmwareCore
+from host.link import protocol_gen as gen
+
+BYTES_PER_MS = gen.BAUD / 10 / 1000  # 8N1: ten bits a byte
+
+
+@dataclass(frozen=True)
+class Faults:
+    """Link faults, applied to every byte in both directions. Rates are probabilities per byte."""
+
+    drop: float = 0.0
+    corrupt: float = 0.0
+    delay_ms: float = 0.0
+    silent_after_ms: float | None = None  # then the line is cut both ways
+    seed: int = 0
+
+
+class Emulator:
+    """The firmware core, a clock in ms, and the serial line to the host.
+
+    Time moves only through advance(); bytes from the host are queued by receive() and reach
+    the core when their due time comes (line rate in line_rate mode, else at once); the core's
+    bytes come back through transmit().
+    """
+
+    def __init__(self, faults: Faults = Faults(), line_rate: bool = True,
+                 reset_cause: int = gen.ResetCause.POWER_ON) -> None:
+        self.faults = faults
+        self.line_rate = line_rate
+        self.now_ms = 0.0
+        self._rng = random.Random(faults.seed)
+        self._core = FirmwareCore(reset_cause, 0)
+        self._inbound: deque[tuple[float, int]] = deque()
+        self._outbound: deque[tuple[float, int]] = deque()
+        self._line_free_ms = 0.0  # when the line to the robot is free again
+        self._tx_free_ms = 0.0    # when the line to the host is free again
+        self._ticked_ms = 0
+        self.lock = threading.RLock()
+        self._collect()
+
+    @property
+    def silent(self) -> bool:
+        after = self.faults.silent_after_ms
+        return after is not None and self.now_ms >= after
+
+    def _faulty(self, data: bytes) -> list[int]:
+        out = []
+        for b in data:
+            if self.faults.drop and self._rng.random() < self.faults.drop:
+                continue
+            if self.faults.corrupt and self._rng.random() < self.faults.corrupt:
+                b ^= self._rng.randrange(1, 256)
+            out.append(b)
+        return out
+
+    def receive(self, data: bytes) -> None:
+        """Bytes the host wrote, starting on the line now."""
+        with self.lock:
+            if self.silent:
+                return
+            for b in self._faulty(data):
+                start = max(self.now_ms, self._line_free_ms) if self.line_rate else self.now_ms
+                self._line_free_ms = start + (1 / BYTES_PER_MS if self.line_rate else 0.0)
+                self._inbound.append((self._line_free_ms + self.faults.delay_ms, b))
+
+    def transmit(self) -> bytes:
+        """Bytes from the robot that have reached the host by now."""
+        with self.lock:
+            out = bytearray()
+            while self._outbound and self._outbound[0][0] <= self.now_ms:
+                out.append(self._outbound.popleft()[1])
+            return bytes(out)
+
+    def _deliver(self) -> None:
+        while self._inbound and self._inbound[0][0] <= self.now_ms:
+            self._core.rx(bytes([self._inbound.popleft()[1]]), int(self.now_ms))
+
+    def _collect(self) -> None:
+        data = self._core.take_tx()
+        if self.silent:
+            return
+        for b in self._faulty(data):
+            if self.line_rate:
+                self._tx_free_ms = max(self.now_ms, self._tx_free_ms) + 1 / BYTES_PER_MS
+                due = self._tx_free_ms
+            else:
+                due = self.now_ms
+            self._outbound.append((due + self.faults.delay_ms, b))
+
+    def process(self) -> None:
+        """Hand the core every byte due by now, without moving the clock."""
+        with self.lock:
+            self._deliver()
+            self._collect()
+
+    def advance(self, ms: float) -> None:
+        """Move the clock on by ms, ticking the core every millisecond."""
+        with self.lock:
+            end = self.now_ms + ms
+            while self.now_ms < end:
+                self.now_ms = min(end, float(int(self.now_ms) + 1))
+                self._deliver()
+                if int(self.now_ms) != self._ticked_ms:
+                    self._ticked_ms = int(self.now_ms)
+                    self._core.tick(self._ticked_ms)
+                self._collect()
+
+    def motors(self) -> tuple[int, int]:
+        """Applied duty (permille) of the left and right motor."""
+        with self.lock:
+            return self._core.motors()
+
+
+class PtyService:
+    """Serves an emulator on a pseudo-terminal from a background thread.
+
+    realtime: the clock follows the wall clock. Otherwise the caller moves it (advance) and
+    bytes are handled at once at the current time, which keeps a simulation deterministic.
+    """
+
+    def __init__(self, emulator: Emulator, realtime: bool = True) -> None:
+        self.emulator = emulator
+        self.realtime = realtime
+        self._master, self._slave = os.openpty()
+        tty.setraw(self._slave)  # raw mode; the slave stays open so clients may come and go
+        os.set_blocking(self._master, False)
+        self.path = os.ttyname(self._slave)
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="pty-emulator", daemon=True)
+
+    def start(self) -> "PtyService":
+        self._thread.start()
+        return self
+
+    def _run(self) -> None:
+        t0 = time.monotonic()
+        emu = self.emulator
+        while not self._stop.is_set():
+            ready, _, _ = select.select([self._master], [], [], 0.001)
+            if ready:
+                try:
+                    emu.receive(os.read(self._master, 4096))
+                except OSError:
+                    pass  # no client has the port open
+            if self.realtime:
+                now = (time.monotonic() - t0) * 1000
+                if now > emu.now_ms:
+                    emu.advance(now - emu.now_ms)
+            else:
+                emu.process()
+            out = emu.transmit()
+            if out:
+                try:
+                    os.write(self._master, out)
+                except OSError:
+                    pass
+
+    def close(self) -> None:
+        self._stop.set()
+        if self._thread.is_alive():
+            self._thread.join(timeout=2)
+        for fd in (self._master, self._slave):
+            try:
+                os.close(fd)
+            except OSError:
+                pass
+
+    def __enter__(self) -> "PtyService":
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

@@ -1,0 +1,196 @@
+"""The host's end of the serial link: handshake, numbered commands with ACK and resend, status.
+
+    with RobotLink("/dev/ttyACM0") as robot:   # opens, says HELLO, checks the schema hash
+        robot.drive(300, 300)                  # permille duty; resent until acknowledged
+        robot.keepalive()                      # call at least every keepalive_s while driving
+    # leaving the block sends STOP, also on an exception or Ctrl-C
+
+Every failure is a LinkError with a one-line message.
+"""
+
+from __future__ import annotations
+
+import random
+import time
+from typing import Any, Callable
+
+import serial
+
+from host.errors import HostError
+from host.link import protocol_gen as gen
+from host.link.frame import FrameDecoder, encode_frame
+from host.link.messages import ProtocolError, pack, unpack
+
+
+class LinkError(HostError):
+    """The serial link or the robot failed; the message is one line."""
+
+
+class RobotLink:
+    """A session with the robot over a serial port (a device path or a pyserial URL)."""
+
+    def __init__(self, port: str, *, baud: int = gen.BAUD, reply_timeout_s: float = 0.1,
+                 retries: int = 8, handshake_s: float = 3.0, keepalive_s: float = 0.08,
+                 expected_hash: int = gen.SCHEMA_HASH) -> None:
+        self.port = port
+        self.baud = baud
+        self.reply_timeout_s = reply_timeout_s
+        self.retries = retries
+        self.handshake_s = handshake_s
+        self.keepalive_s = keepalive_s
+        self.expected_hash = expected_hash
+        self.hello: Any = None
+        self.duplicates = 0  # resends the robot had already applied
+        self._ser: serial.Serial | None = None
+        self._dec = FrameDecoder()
+        self._seq = random.randrange(256)
+        self._last_drive: tuple[int, int] | None = None
+        self._last_sent = 0.0
+
+    # ----------------------------------------------------------------------------- port I/O
+
+    def open(self) -> "RobotLink":
+        try:
+            self._ser = serial.serial_for_url(self.port, baudrate=self.baud, timeout=0.005,
+                                              write_timeout=1.0)
+        except (serial.SerialException, OSError, ValueError) as e:
+            raise LinkError(f"cannot open {self.port}: {_reason(e)}") from None
+        self.hello = self._handshake()
+        return self
+
+    def _write(self, data: bytes) -> None:
+        assert self._ser is not None
+        try:
+            self._ser.write(data)
+        except (serial.SerialException, OSError) as e:
+            raise LinkError(f"lost the serial port {self.port}: {_reason(e)}") from None
+        self._last_sent = time.monotonic()
+
+    def _messages(self) -> list[Any]:
+        assert self._ser is not None
+        try:
+            data = self._ser.read(max(1, self._ser.in_waiting))
+        except (serial.SerialException, OSError) as e:
+            raise LinkError(f"lost the serial port {self.port}: {_reason(e)}") from None
+        out = []
+        for f in self._dec.feed(data):
+            try:
+                msg = unpack(f.id, f.payload)
+            except ProtocolError:
+                continue  # a frame from a robot of another spec; the handshake says so
+            if isinstance(msg, gen.Boot) and self.hello is not None:
+                raise LinkError(f"the robot reset during the session (cause "
+                                f"{gen.ResetCause(msg.reset_cause).name.lower()})")
+            out.append(msg)
+        return out
+
+    def _await(self, match: Callable[[Any], bool], timeout_s: float) -> Any:
+        deadline = time.monotonic() + timeout_s
+        while time.monotonic() < deadline:
+            for msg in self._messages():
+                if match(msg):
+                    return msg
+        return None
+
+    # ----------------------------------------------------------------------------- protocol
+
+    def _handshake(self) -> Any:
+        # An Uno resets when the port opens; its bootloader needs a moment, so HELLO is resent
+        # until the reply with this nonce comes or handshake_s runs out.
+        nonce = random.getrandbits(32)
+        deadline = time.monotonic() + self.handshake_s
+        while time.monotonic() < deadline:
+            self._write(encode_frame(self._next_seq(), *pack(gen.Hello(nonce=nonce))))
+            reply = self._await(lambda m: isinstance(m, gen.HelloReply) and m.nonce == nonce,
+                                min(0.25, max(0.0, deadline - time.monotonic())))
+            if reply is None:
+                continue
+            if reply.schema_hash != self.expected_hash:
+                raise LinkError(f"protocol mismatch: the robot's firmware was built from spec "
+                                f"0x{reply.schema_hash:08X}, this host from 0x"
+                                f"{self.expected_hash:08X}; flash the firmware built from this "
+                                f"checkout")
+            return reply
+        raise LinkError(f"no answer from a robot on {self.port} within {self.handshake_s:g} s "
+                        f"(is the firmware flashed and the port right?)")
+
+    def _next_seq(self) -> int:
+        self._seq = (self._seq + 1) & 0xFF
+        return self._seq
+
+    def _transact(self, msg: Any, match: Callable[[Any, int], bool]) -> Any:
+        """Send msg and wait for the reply match accepts; resend on silence or a CRC NACK."""
+        seq = self._next_seq()
+        frame = encode_frame(seq, *pack(msg))
+        for _ in range(self.retries):
+            self._write(frame)
+            reply = self._await(lambda m: match(m, seq), self.reply_timeout_s)
+            if reply is None:
+                continue
+            if isinstance(reply, gen.Nack):
+                if reply.error == gen.Error.BAD_CRC:
+                    continue
+                raise LinkError(f"the robot refused {msg.NAME}: "
+                                f"{gen.Error(reply.error).name.lower().replace('_', ' ')}")
+            return reply
+        raise LinkError(f"the robot did not answer {msg.NAME} after {self.retries} tries "
+                        f"({self.reply_timeout_s * 1000:.0f} ms each)")
+
+    def command(self, msg: Any) -> Any:
+        """Send a command and return its ACK."""
+        ack = self._transact(msg, lambda m, seq: isinstance(m, (gen.Ack, gen.Nack))
+                             and m.seq == seq)
+        if ack.result == gen.AckResult.DUPLICATE:
+            self.duplicates += 1
+        return ack
+
+    def drive(self, left: int, right: int) -> None:
+        """Set both motors' duty in permille (-1000..1000, positive = forward)."""
+        self.command(gen.SetDrive(left=int(left), right=int(right)))
+        self._last_drive = (int(left), int(right))
+
+    def stop(self) -> None:
+        self.command(gen.Stop())
+        self._last_drive = None
+
+    def keepalive(self) -> None:
+        """Resend the drive command when nothing was sent for keepalive_s, well inside the
+        firmware's link-loss timeout; does nothing while stopped."""
+        if self._last_drive and time.monotonic() - self._last_sent >= self.keepalive_s:
+            self.drive(*self._last_drive)
+
+    def set_config(self, link_timeout_ms: int, accel_limit: int = 0) -> None:
+        self.command(gen.SetConfig(link_timeout_ms=link_timeout_ms, accel_limit=accel_limit))
+
+    def status(self) -> Any:
+        """The robot's STATUS message."""
+        return self._transact(gen.GetStatus(), lambda m, seq: isinstance(m, gen.Status) or (
+            isinstance(m, gen.Nack) and m.seq == seq))
+
+    def close(self) -> None:
+        """Stop the motors (best effort) and close the port."""
+        if self._ser is None:
+            return
+        try:
+            if self.hello is not None:
+                self.stop()
+        except LinkError:
+            pass  # the port is gone or the robot silent: its link-loss timeout stops it
+        finally:
+            self._ser.close()
+            self._ser = None
+
+    def __enter__(self) -> "RobotLink":
+        return self.open()
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def _reason(e: BaseException) -> str:
+    text = str(e).strip() or type(e).__name__
+    if "No such file" in text or "could not open port" in text and "[Errno 2]" in text:
+        return "no such device"
+    if "Permission denied" in text or "[Errno 13]" in text:
+        return "permission denied (add yourself to the dialout group)"
+    return text.splitlines()[0]
