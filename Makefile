@@ -26,13 +26,15 @@ demo: venv
 	@mkdir -p $(OUT)
 	$(BIN)/host eval --picture $(OUT)
 	$(BIN)/host eval --matcher ncc --window 5 --border clip --lr-check 1 --fill --median 5
-	@echo "disparity picture: $(OUT)/motorcycle.png"
+	$(BIN)/host tune --border clip --out $(OUT)/tuned.toml --plot $(OUT)/tuning.png
+	@echo "disparity picture: $(OUT)/motorcycle.png, tuning figure: $(OUT)/tuning.png"
 
 test: venv system-deps
 	$(BIN)/python -m pytest
 
 bench: venv
 	$(BIN)/python bench/matcher.py
+	$(BIN)/python bench/tuning.py
 	$(BIN)/python bench/protocol.py
 	$(BIN)/python bench/firmware.py
 	$(BIN)/python bench/link.py

@@ -5,16 +5,24 @@ from __future__ import annotations
 import argparse
 import sys
 
-from host.commands import disparity, emulate, eval as eval_cmd
+from host.commands import disparity, emulate, eval as eval_cmd, tune
 from host.errors import HostError
 
-COMMANDS = [eval_cmd, disparity, emulate]
+COMMANDS = [eval_cmd, disparity, tune, emulate]
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with a one-line error (no usage block) and exit status 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="host", description="stereo-servo host: stereo matching, tuning and the robot servo")
-    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND",
+                                parser_class=_Parser)
     for command in COMMANDS:
         command.add_parser(sub)
     return parser
@@ -31,6 +39,9 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"host {args.command}: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # the reader (head, less) went away: not an error of ours
+        sys.stderr.close()
+        return 0
 
 
 if __name__ == "__main__":

@@ -1,0 +1,228 @@
+"""Tuning methods over a Space, all paying in distinct objective evaluations.
+
+- paper: the paper's learner. States are window sizes, actions shrink / keep / grow, Q starts at
+  zero, and each iteration applies the paper's equation 6, Q(s, a) = R(s, a) + gamma * max Q(s', .),
+  with epsilon-greedy action choice.
+- qlearning: standard Q-learning, Q += alpha * (R + gamma * max Q(s', .) - Q), epsilon decaying
+  over the run, in episodes that start from a random state or from the best state found so far.
+- grid: every state. random: states drawn without replacement.
+
+The reward is the improvement of the bad-pixel rate, R(s, a) = bad(s) - bad(s') in percentage
+points: positive for a move to a better state, zero for keep. With Q starting at zero, an untried
+action looks better than a tried worse one, so the learners explore the neighbours of a state
+before they settle.
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from host.errors import HostError
+from host.tuning.objective import Objective, State
+from host.tuning.spaces import Space
+
+METHODS = ("paper", "qlearning", "grid", "random")
+
+
+class Run:
+    """The objective as one run sees it: remembers which states this run evaluated, in order
+    (the objective's cache may be shared between runs, as in the benchmark)."""
+
+    def __init__(self, obj: Objective) -> None:
+        self.obj = obj
+        self.visited: dict[State, float] = {}
+
+    def __call__(self, state: State) -> float:
+        if state not in self.visited:
+            self.visited[state] = self.obj(state)
+        return self.visited[state]
+
+    def many(self, states: list[State]) -> list[float]:
+        for s, bad in zip(states, self.obj.many(states)):
+            self.visited.setdefault(s, bad)
+        return [self.visited[s] for s in states]
+
+    def best(self) -> tuple[State, float]:
+        state = min(self.visited, key=lambda s: (self.visited[s], s))
+        return state, self.visited[state]
+
+
+@dataclass
+class TuneResult:
+    method: str
+    space: Space
+    best_state: State
+    best_bad: float
+    visited: list[tuple[State, float]]  # distinct states in the order this run evaluated them
+    history: list[tuple[State, float]]  # one entry per iteration: state visited, its bad %
+    q_table: dict[State, np.ndarray] = field(default_factory=dict)
+
+    @property
+    def evaluations(self) -> int:
+        return len(self.visited)
+
+    def evaluations_to_reach(self, target: float) -> int | None:
+        """Distinct evaluations this run needed before one scored <= target (None: never)."""
+        for i, (_, bad) in enumerate(self.visited):
+            if bad <= target:
+                return i + 1
+        return None
+
+    def best_so_far(self) -> list[float]:
+        out, best = [], float("inf")
+        for _, bad in self.history:
+            best = min(best, bad)
+            out.append(best)
+        return out
+
+    def to_json(self) -> dict[str, Any]:
+        return {"method": self.method, "space": self.space.name,
+                "best_params": self.space.values(self.best_state), "best_bad": self.best_bad,
+                "evaluations": self.evaluations, "iterations": len(self.history),
+                "history": [{"params": self.space.values(s), "bad": b} for s, b in self.history]}
+
+
+def paper_update(q: np.ndarray, s: int, a: int, reward: float, s_next: int,
+                 gamma: float) -> None:
+    """The paper's equation 6: Q(s, a) = R(s, a) + gamma * max over a' of Q(s', a')."""
+    q[s, a] = reward + gamma * q[s_next].max()
+
+
+def q_update(q: dict[State, np.ndarray], s: State, a: int, reward: float, s_next: State,
+             alpha: float, gamma: float) -> None:
+    """Q-learning: Q(s, a) += alpha * (R + gamma * max Q(s', .) - Q(s, a))."""
+    q[s][a] += alpha * (reward + gamma * q[s_next].max() - q[s][a])
+
+
+def _greedy(values: np.ndarray, epsilon: float, rng: np.random.Generator, keep: int,
+            prefer: int | None) -> int:
+    """Epsilon-greedy over Q. Ties never go to keep (it earns nothing and teaches nothing while
+    a neighbour is untried, so keep wins only when strictly best); among tied moves, prefer
+    the one the last reward favours: repeat a move that improved, undo one that did not."""
+    if rng.random() < epsilon:
+        return int(rng.integers(len(values)))
+    best = np.flatnonzero(values == values.max())
+    if len(best) == 1:
+        return int(best[0])
+    best = best[best != keep]
+    if prefer is not None and prefer in best:
+        return prefer
+    return int(rng.choice(best))
+
+
+def _result(method: str, space: Space, run: Run, history: list[tuple[State, float]],
+            q: dict[State, np.ndarray] | None = None) -> TuneResult:
+    best, best_bad = run.best()
+    return TuneResult(method, space, best, best_bad, list(run.visited.items()), history, q or {})
+
+
+def paper(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
+          gamma: float = 0.8, epsilon: float = 0.2, step: int = 1,
+          on_step: Callable[[], None] | None = None) -> TuneResult:
+    if len(space.dims) != 1:
+        raise HostError(f"the paper's learner tunes one parameter; space {space.name} has "
+                        f"{len(space.dims)} (use --method qlearning)")
+    n = space.shape[0]
+    q = np.zeros((n, 3))  # actions: shrink, keep, grow
+    s = int(rng.integers(n))
+    bad_s = obj((s,))
+    history = []
+    prefer = None
+    for _ in range(iterations):
+        a = _greedy(q[s], epsilon, rng, keep=1, prefer=prefer)
+        s2 = min(max(s + (a - 1) * step, 0), n - 1)
+        bad2 = obj((s2,))
+        reward = bad_s - bad2
+        paper_update(q, s, a, reward, s2, gamma)
+        prefer = a if reward > 0 else 2 - a  # repeat an improving move, else undo it
+        s, bad_s = s2, bad2
+        history.append(((s2,), bad2))
+        if on_step:
+            on_step()
+    return _result("paper", space, obj, history, {(i,): q[i].copy() for i in range(n)})
+
+
+def qlearning(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
+              episodes: int = 20, alpha: float = 0.5, gamma: float = 0.9, epsilon: float = 0.3,
+              epsilon_final: float = 0.02, restart_best: float = 0.9, step: int = 1,
+              on_step: Callable[[], None] | None = None) -> TuneResult:
+    actions = space.actions
+    opposite = [actions.index((d, -sign)) if d >= 0 else 0 for d, sign in actions]
+    q: dict[State, np.ndarray] = defaultdict(lambda: np.zeros(len(actions)))
+    decay = (epsilon_final / epsilon) ** (1 / max(1, iterations - 1))
+    per_episode = -(-iterations // episodes)
+    history: list[tuple[State, float]] = []
+    states = space.states()
+    for _ in range(episodes):
+        if history and rng.random() < restart_best:
+            s = obj.best()[0]
+        else:
+            s = states[int(rng.integers(len(states)))]
+        bad_s = obj(s)
+        prefer = None
+        for _ in range(per_episode):
+            if len(history) == iterations:
+                break
+            a = _greedy(q[s], epsilon * decay ** len(history), rng, keep=0, prefer=prefer)
+            s2 = space.move(s, actions[a], step)
+            bad2 = obj(s2)
+            reward = bad_s - bad2
+            q_update(q, s, a, reward, s2, alpha, gamma)
+            prefer = a if reward > 0 else opposite[a]
+            s, bad_s = s2, bad2
+            history.append((s2, bad2))
+            if on_step:
+                on_step()
+    return _result("qlearning", space, obj, history, dict(q))
+
+
+def grid(obj: Run, space: Space, on_step: Callable[[], None] | None = None) -> TuneResult:
+    history = []
+    states = space.states()
+    chunk = 32
+    for i in range(0, len(states), chunk):
+        part = states[i:i + chunk]
+        for s, bad in zip(part, obj.many(part)):
+            history.append((s, bad))
+            if on_step:
+                on_step()
+    return _result("grid", space, obj, history)
+
+
+def random_search(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
+                  on_step: Callable[[], None] | None = None) -> TuneResult:
+    states = space.states()
+    order = rng.permutation(len(states))[:iterations]
+    picked = [states[i] for i in order]
+    history = []
+    chunk = 32
+    for i in range(0, len(picked), chunk):
+        part = picked[i:i + chunk]
+        for s, bad in zip(part, obj.many(part)):
+            history.append((s, bad))
+            if on_step:
+                on_step()
+    return _result("random", space, obj, history)
+
+
+def tune(method: str, obj: Objective, space: Space, iterations: int, seed: int,
+         on_step: Callable[[], None] | None = None, **hyper: Any) -> TuneResult:
+    """Run a method by name; iterations is ignored by grid (it visits every state)."""
+    if iterations < 1 and method != "grid":
+        raise HostError(f"iterations must be at least 1, got {iterations}")
+    rng = np.random.default_rng(seed)
+    run = Run(obj)
+    if method == "paper":
+        return paper(run, space, iterations, rng, on_step=on_step, **hyper)
+    if method == "qlearning":
+        return qlearning(run, space, iterations, rng, on_step=on_step, **hyper)
+    if method == "grid":
+        return grid(run, space, on_step=on_step)
+    if method == "random":
+        return random_search(run, space, iterations, rng, on_step=on_step)
+    raise HostError(f"unknown method {method!r} (choose from {', '.join(METHODS)})")

@@ -1,0 +1,93 @@
+"""host tune on real images: the window learner ends near the grid optimum; files and JSON."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from host.cli import main
+from host.params_file import load_params
+from host.stereo import MatcherParams
+from host.stereo.synthetic import synthetic_scene
+from host.tuning.learners import tune
+from host.tuning.objective import Objective
+from host.tuning.spaces import make_space, odd_range
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return synthetic_scene(seed=11, width=200, height=150, max_disp=24, noise=2.0)
+
+
+def test_window_tuning_ends_within_half_a_point_of_the_grid_best(scene) -> None:
+    space = make_space("window", MatcherParams(num_disparities=32), odd_range("3:27"))
+    obj = Objective.on_scenes([scene], space.params)
+    best_grid = tune("grid", obj, space, 0, 0).best_bad
+    for seed in range(3):
+        r = tune("paper", obj, space, 20, seed)
+        assert r.best_bad <= best_grid + 0.5, (seed, r.best_bad, best_grid)
+
+
+def test_tune_writes_params_plot_and_json(tmp_path: Path, capsys) -> None:
+    out, fig = tmp_path / "p.toml", tmp_path / "fig.png"
+    assert main(["tune", "--iterations", "6", "--windows", "7:15", "--out", str(out),
+                 "--plot", str(fig), "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    for key in ("method", "space", "best_params", "best_bad", "evaluations", "iterations",
+                "history"):
+        assert key in result
+    assert result["method"] == "paper" and result["iterations"] == 6 == len(result["history"])
+    assert set(result["history"][0]) == {"params", "bad"}
+    params, tuning = load_params(out)
+    assert params.block_size == result["best_params"]["block_size"]
+    assert tuning["method"] == "paper" and tuning["scenes"] == ["motorcycle"]
+    assert abs(tuning["bad"] - result["best_bad"]) < 1e-3
+    img = cv2.imread(str(fig))
+    assert img is not None and img.shape[1] > 800
+    assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".")] == []
+
+
+def test_tuned_params_round_trip_into_eval(tmp_path: Path, capsys) -> None:
+    out = tmp_path / "p.toml"
+    assert main(["tune", "--method", "grid", "--windows", "9:13", "--out", str(out)]) == 0
+    capsys.readouterr()
+    assert main(["eval", "--params", str(out), "--json"]) == 0
+    row = json.loads(capsys.readouterr().out)
+    assert row["matcher"]["block_size"] == load_params(out)[0].block_size
+
+
+def _run(*argv: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "host", "tune", *argv], capture_output=True,
+                          text=True)
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--space", "nope"], "invalid choice"),
+    (["--method", "nope"], "invalid choice"),
+    (["--iterations", "0"], "at least 1"),
+    (["--space", "sad"], "tunes one parameter"),
+    (["--windows", "4:10"], "odd bounds"),
+])
+def test_bad_input_is_a_one_line_error(argv: list[str], message: str) -> None:
+    r = _run(*argv)
+    assert r.returncode == 2 and message in r.stderr and r.stderr.count("\n") == 1
+
+
+def test_a_scene_without_ground_truth_is_refused(tmp_path: Path) -> None:
+    for name in ("im0.png", "im1.png"):
+        cv2.imwrite(str(tmp_path / name), np.zeros((40, 80), np.uint8))
+    r = _run(str(tmp_path))
+    assert r.returncode == 2 and "no ground truth" in r.stderr
+
+
+def test_an_interrupted_run_leaves_no_params_file(tmp_path: Path) -> None:
+    out = tmp_path / "p.toml"
+    out.write_text("[matcher]\nblock_size = 7\n")
+    r = _run("--iterations", "0", "--out", str(out))
+    assert r.returncode == 2 and out.read_text() == "[matcher]\nblock_size = 7\n"
