@@ -1,0 +1,142 @@
+"""Replay and Minoru sources: pairing, skew, sizes and errors, on files the tests write."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from host.camera import minoru
+from host.camera.minoru import MinoruSource, find_minoru
+from host.camera.replay import ReplaySource
+from host.camera.source import CameraError
+from host.cli import main
+
+from .boards import BOARD, SQUARE_MM, views
+
+
+def _video(path: Path, fps: float, n: int, size=(320, 240)) -> None:
+    out = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"MJPG"), fps, size)
+    for i in range(n):
+        img = np.full((size[1], size[0], 3), (i * 7) % 255, np.uint8)
+        cv2.putText(img, str(i), (20, 100), cv2.FONT_HERSHEY_SIMPLEX, 2, (255, 255, 255), 3)
+        out.write(img)
+    out.release()
+
+
+def _files(left: Path, right: Path):
+    paths = {"L": str(left), "R": str(right)}
+    return lambda device, w, h, fps: cv2.VideoCapture(paths[device])
+
+
+def test_minoru_grabs_both_then_retrieves_and_pairs_in_time(tmp_path: Path) -> None:
+    _video(tmp_path / "l.avi", 30, 30)
+    _video(tmp_path / "r.avi", 30, 30)
+    src = MinoruSource(devices=("L", "R"), open_capture=_files(tmp_path / "l.avi",
+                                                               tmp_path / "r.avi"))
+    frames = [src.read() for _ in range(30)]
+    with pytest.raises(CameraError, match="stopped delivering"):  # a camera never just ends
+        src.read()
+    assert src.dropped == 0
+    assert all(f.skew_ms < 1 for f in frames) and frames[1].t - frames[0].t == pytest.approx(1 / 30)
+
+
+def test_minoru_drops_pairs_whose_skew_exceeds_the_bound(tmp_path: Path) -> None:
+    _video(tmp_path / "l.avi", 30, 40)
+    _video(tmp_path / "r.avi", 15, 20)  # the right sensor delivers half as often
+    src = MinoruSource(devices=("L", "R"), open_capture=_files(tmp_path / "l.avi",
+                                                               tmp_path / "r.avi"))
+    frames = []
+    with pytest.raises(CameraError):  # the left stream ends first: a clean error, not a hang
+        for f in src:
+            frames.append(f)
+    assert len(frames) >= 15 and src.dropped >= 15
+    assert all(f.skew_ms <= src.max_skew_ms for f in frames)
+
+
+def test_minoru_swap_exchanges_the_devices(tmp_path: Path) -> None:
+    _video(tmp_path / "l.avi", 30, 3, (320, 240))
+    _video(tmp_path / "r.avi", 30, 3, (320, 240))
+    src = MinoruSource(devices=("L", "R"), swap=True,
+                       open_capture=_files(tmp_path / "l.avi", tmp_path / "r.avi"))
+    assert src.devices == ("R", "L")
+
+
+def test_minoru_not_found_and_unsupported_mode(tmp_path: Path, monkeypatch) -> None:
+    monkeypatch.setattr(minoru, "SYSFS", tmp_path)
+    with pytest.raises(CameraError, match="no Minoru found"):
+        MinoruSource()
+    with pytest.raises(CameraError, match="not 640x360"):
+        MinoruSource((640, 360), devices=("a", "b"))
+
+
+def test_find_minoru_reads_sysfs(tmp_path: Path) -> None:
+    usb = tmp_path / "devices" / "1-1"
+    for n, pid in ((0, "3410"), (2, "3420")):
+        iface = usb / f"sensor{n}" / "1-1:1.0"
+        iface.mkdir(parents=True)
+        (iface.parent / "idVendor").write_text("0ac8\n")
+        (iface.parent / "idProduct").write_text(pid + "\n")
+        for index in (0, 1):
+            dev = tmp_path / f"video{n + index}"
+            dev.mkdir()
+            (dev / "name").write_text("Vimicro USB2.0 PC Camera\n")
+            (dev / "index").write_text(f"{index}\n")
+            os.symlink(iface, dev / "device")
+    assert find_minoru(tmp_path) == ["/dev/video0", "/dev/video2"]
+
+
+def test_a_vanished_camera_is_a_clear_error() -> None:
+    class Gone:
+        def grab(self) -> bool:
+            return False
+
+        def release(self) -> None:
+            pass
+
+    src = MinoruSource(devices=("/dev/video0", "/dev/video2"), open_capture=lambda *a: Gone())
+    with pytest.raises(CameraError, match="/dev/video0 stopped delivering frames"):
+        src.read()
+
+
+def test_replay_folder_of_pairs_and_mismatched_sizes(tmp_path: Path) -> None:
+    for i in range(3):
+        cv2.imwrite(str(tmp_path / f"left_{i:03d}.png"), np.zeros((24, 32, 3), np.uint8))
+        cv2.imwrite(str(tmp_path / f"right_{i:03d}.png"), np.zeros((24, 32, 3), np.uint8))
+    frames = list(ReplaySource(tmp_path, fps=10))
+    assert len(frames) == 3 and frames[2].t == pytest.approx(0.2)
+    cv2.imwrite(str(tmp_path / "right_001.png"), np.zeros((12, 16, 3), np.uint8))
+    with pytest.raises(CameraError, match="differ in size: 32x24 vs 16x12"):
+        list(ReplaySource(tmp_path))
+    (tmp_path / "right_002.png").unlink()
+    with pytest.raises(CameraError, match="no matching right_002.png"):
+        ReplaySource(tmp_path)
+
+
+def test_replay_two_videos(tmp_path: Path) -> None:
+    _video(tmp_path / "left.avi", 30, 5)
+    _video(tmp_path / "right.avi", 30, 5)
+    assert len(list(ReplaySource(tmp_path))) == 5
+
+
+def test_capture_then_calibrate_from_the_command_line(tmp_path: Path, capsys) -> None:
+    shots = tmp_path / "shots"
+    shots.mkdir()
+    for i, f in enumerate(views(10)):
+        cv2.imwrite(str(shots / f"left_{i:03d}.png"), f.left)
+        cv2.imwrite(str(shots / f"right_{i:03d}.png"), f.right)
+    saved = tmp_path / "saved"
+    assert main(["capture", "--camera", f"replay:{shots}", "--count", "8", "--interval", "0",
+                 "--out", str(saved)]) == 0
+    assert len(list(saved.glob("left_*.png"))) == 8
+    calib = tmp_path / "calib.yml"
+    assert main(["calibrate", str(shots), "--board", f"{BOARD[0]}x{BOARD[1]}", "--square",
+                 str(SQUARE_MM), "--out", str(calib)]) == 0
+    out = capsys.readouterr().out
+    assert "reprojection RMS" in out and "baseline 60." in out and calib.exists()
+    assert main(["calibrate", str(shots), "--board", "7x5", "--out",
+                 str(tmp_path / "bad.yml")]) == 2
+    assert not (tmp_path / "bad.yml").exists()
