@@ -27,7 +27,8 @@ demo: venv
 	$(BIN)/host eval --picture $(OUT)
 	$(BIN)/host eval --matcher ncc --window 5 --border clip --lr-check 1 --fill --median 5
 	$(BIN)/host tune --border clip --out $(OUT)/tuned.toml --plot $(OUT)/tuning.png
-	@echo "disparity picture: $(OUT)/motorcycle.png, tuning figure: $(OUT)/tuning.png"
+	$(BIN)/host servo --sim --border clip --num-disp 48 --log $(OUT)/servo.csv --plot $(OUT)/servo.png
+	@echo "pictures: $(OUT)/motorcycle.png (disparity), $(OUT)/tuning.png (tuning), $(OUT)/servo.png (servo run)"
 
 test: venv system-deps
 	$(BIN)/python -m pytest
@@ -38,6 +39,7 @@ bench: venv
 	$(BIN)/python bench/protocol.py
 	$(BIN)/python bench/firmware.py
 	$(BIN)/python bench/link.py
+	$(BIN)/python bench/servo.py
 
 # regenerate everything derived from protocol/spec.toml (tests fail while it is stale)
 protocol: venv

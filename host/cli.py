@@ -5,10 +5,10 @@ from __future__ import annotations
 import argparse
 import sys
 
-from host.commands import calibrate, capture, disparity, emulate, eval as eval_cmd, tune
+from host.commands import calibrate, capture, disparity, emulate, eval as eval_cmd, servo, tune
 from host.errors import HostError
 
-COMMANDS = [eval_cmd, disparity, tune, capture, calibrate, emulate]
+COMMANDS = [eval_cmd, disparity, tune, capture, calibrate, servo, emulate]
 
 
 class _Parser(argparse.ArgumentParser):

@@ -29,7 +29,11 @@ class Layer:
     ellipse: bool = False
 
     def mean_disparity(self, width: int, height: int) -> float:
-        return self.d0 + self.dx * width / 2 + self.dy * height / 2
+        """Disparity at the centre of the layer's visible part (the painting order)."""
+        x0, y0, x1, y1 = self.box or (0, 0, width, height)
+        x0, x1 = max(x0, 0), min(x1, width)
+        y0, y1 = max(y0, 0), min(y1, height)
+        return self.d0 + self.dx * (x0 + x1) / 2 + self.dy * (y0 + y1) / 2
 
 
 def random_texture(rng: np.random.Generator, height: int, width: int, sigma: float = 1.0,

@@ -1,0 +1,1 @@
+"""The disparity-equalising servo: perception, marker, control law, the loop and its simulation."""
