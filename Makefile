@@ -10,7 +10,7 @@ DATA ?= $(abspath ../shared/data)
 # tests and benchmarks find the Middlebury scenes through this variable
 export STEREO_SERVO_DATA ?= $(if $(wildcard $(DATA)/middlebury/index.json),$(DATA),)
 
-.PHONY: demo test bench venv system-deps protocol firmware flash clean
+.PHONY: demo test lint bench venv system-deps protocol firmware flash clean
 
 $(BIN)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -30,8 +30,11 @@ demo: venv
 	$(BIN)/host servo --sim --border clip --num-disp 48 --log $(OUT)/servo.csv --plot $(OUT)/servo.png
 	@echo "pictures: $(OUT)/motorcycle.png (disparity), $(OUT)/tuning.png (tuning), $(OUT)/servo.png (servo run)"
 
-test: venv system-deps
+test: venv system-deps lint
 	$(BIN)/python -m pytest
+
+lint: venv
+	$(BIN)/ruff check host tools bench tests
 
 bench: venv
 	$(BIN)/python bench/matcher.py

@@ -28,6 +28,11 @@ def median_reach(results, target: float) -> str:
     return f"{med:5.1f} ({len(ok)}/{len(reach)} runs reach it)"
 
 
+def best_within(result, budget: int) -> float:
+    """The best bad % a run had found after `budget` distinct evaluations."""
+    return min(bad for _, bad in result.visited[:budget])
+
+
 def main() -> int:
     data = os.environ.get("STEREO_SERVO_DATA")
     if not data:
@@ -49,7 +54,8 @@ def main() -> int:
             runs = {m: [tune(m, obj, space, min(STEPS[m], space.size) if m == "random"
                              else STEPS[m], s) for s in SEEDS] for m in methods}
             for m, results in runs.items():
-                print(f"  {m:<10} evaluations to within 0.5 points: {median_reach(results, target)}")
+                print(f"  {m:<10} evaluations to within 0.5 points: "
+                      f"{median_reach(results, target)}")
             q = [r.evaluations_to_reach(target) or space.size for r in runs["qlearning"]]
             budget = int(statistics.median(q))
             rnd = [tune("random", obj, space, budget, s) for s in SEEDS]
@@ -59,7 +65,7 @@ def main() -> int:
             print(f"  at the Q-learner's median budget of {budget} evaluations "
                   f"({100 * budget / space.size:.1f}% of the grid): qlearning reaches it in "
                   f"{hit_q}/20 runs, random in {hit_r}/20; median best bad qlearning "
-                  f"{statistics.median(min(b for _, b in r.visited[:budget]) for r in runs['qlearning']):.2f}%, "
+                  f"{statistics.median(best_within(r, budget) for r in runs['qlearning']):.2f}%, "
                   f"random {statistics.median(r.best_bad for r in rnd):.2f}%")
             tuned[(space_name, name)] = space.params(g.best_state)
     print("\ngeneralisation (grid-tuned parameters, bad % nonocc):")

@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from host.commands import calibrate, capture, disparity, emulate, eval as eval_cmd, servo, tune
+from host.commands import calibrate, capture, disparity, emulate, servo, tune
+from host.commands import eval as eval_cmd
 from host.errors import HostError
 
 COMMANDS = [eval_cmd, disparity, tune, capture, calibrate, servo, emulate]

@@ -169,7 +169,8 @@ def render_c(spec: Spec) -> str:
            "#define PROTO_HEADER_LEN 4 /* START LEN SEQ ID */",
            "#define PROTO_CRC_LEN 2",
            "#define PROTO_FRAME_MAX (PROTO_HEADER_LEN + PROTO_MAX_PAYLOAD + PROTO_CRC_LEN)",
-           "#define PROTO_CRC_INIT 0xFFFFu /* CRC-16/CCITT-FALSE: _crc_xmodem_update from 0xFFFF */"]
+           "#define PROTO_CRC_INIT 0xFFFFu"
+           " /* CRC-16/CCITT-FALSE: _crc_xmodem_update from 0xFFFF */"]
     for k, v in spec.raw["defaults"].items():
         out.append(f"#define PROTO_DEFAULT_{k.upper()} {v}")
     for name, enum in spec.raw.get("enum", {}).items():
@@ -234,7 +235,8 @@ def render_c(spec: Spec) -> str:
     out += ["    default: (void)payload; return 0;", "    }", "}", "",
             "/* 1 when the robot receives this id, 0 when it sends it or no message has it. */",
             "static inline uint8_t proto_is_host_to_robot(uint8_t id)", "{", "    switch (id) {"]
-    out += [f"    case PROTO_MSG_{m.name}:" for m in spec.messages if m.direction == "host_to_robot"]
+    out += [f"    case PROTO_MSG_{m.name}:" for m in spec.messages
+            if m.direction == "host_to_robot"]
     out += ["        return 1;", "    default:", "        return 0;", "    }", "}", "",
             "#endif /* PROTOCOL_GEN_H */", ""]
     return "\n".join(out)
@@ -256,10 +258,11 @@ def render_c_format(spec: Spec) -> str:
     for m in spec.messages:
         out.append(f"    case PROTO_MSG_{m.name}: {{")
         if not m.fields:
-            out += [f"        (void)payload;",
+            out += ["        (void)payload;",
                     f"        return snprintf(out, n, \"{m.name}\");", "    }"]
             continue
-        out += [f"        struct proto_{m.snake} m;", f"        proto_{m.snake}_unpack(payload, &m);"]
+        out += [f"        struct proto_{m.snake} m;",
+                f"        proto_{m.snake}_unpack(payload, &m);"]
         fmt = " ".join(f"{f.name}=%ld" for f in m.fields)
         args = ", ".join(f"(long)m.{f.name}" for f in m.fields)
         out += [f"        return snprintf(out, n, \"{m.name} {fmt}\", {args});", "    }"]
@@ -271,11 +274,14 @@ def render_c_format(spec: Spec) -> str:
 
 def render_python(spec: Spec) -> str:
     p = spec.p
-    out = [f"# {BANNER}", '"""The serial protocol\'s constants and messages (docs/protocol.md)."""', "",
-           "from __future__ import annotations", "", "import enum", "from dataclasses import dataclass",
+    out = [f"# {BANNER}",
+           '"""The serial protocol\'s constants and messages (docs/protocol.md)."""', "",
+           "from __future__ import annotations", "", "import enum",
+           "from dataclasses import dataclass",
            "from typing import ClassVar", "",
            f"SCHEMA_HASH = 0x{spec.schema_hash:08X}", f"VERSION = {p['version']}",
-           f"BAUD = {p['baud']}", f"START = 0x{p['start']:02X}", f"MAX_PAYLOAD = {p['max_payload']}",
+           f"BAUD = {p['baud']}", f"START = 0x{p['start']:02X}",
+           f"MAX_PAYLOAD = {p['max_payload']}",
            "HEADER_LEN = 4  # START LEN SEQ ID", "CRC_LEN = 2", f'CRC_NAME = "{p["crc"]}"']
     for k, v in spec.raw["defaults"].items():
         out.append(f"DEFAULT_{k.upper()} = {v}")
@@ -291,7 +297,8 @@ def render_python(spec: Spec) -> str:
         fmt = "<" + "".join(TYPES[f.type][3] for f in m.fields)
         out += ["", "", "@dataclass(frozen=True)", f"class {m.camel}:", f'    """{m.doc}"""', "",
                 f"    ID: ClassVar[int] = 0x{m.id:02X}", f'    NAME: ClassVar[str] = "{m.name}"',
-                f'    DIRECTION: ClassVar[str] = "{m.direction}"', f'    FORMAT: ClassVar[str] = "{fmt}"',
+                f'    DIRECTION: ClassVar[str] = "{m.direction}"',
+                f'    FORMAT: ClassVar[str] = "{fmt}"',
                 f"    SIZE: ClassVar[int] = {m.size}",
                 "    RANGES: ClassVar[dict[str, tuple[int, int]]] = {"]
         out += [f'        "{f.name}": ({f.min}, {f.max}),' for f in m.fields]
@@ -355,7 +362,8 @@ def render_docs(spec: Spec) -> str:
         out += [f"| {v['value']} | {v['name']} | {v['doc']} |" for v in enum["values"]]
         out.append("")
     for name, flags in spec.raw.get("flags", {}).items():
-        out += [f"### flags {name}", "", flags["doc"], "", "| bit | name | meaning |", "|---|---|---|"]
+        out += [f"### flags {name}", "", flags["doc"], "", "| bit | name | meaning |",
+                "|---|---|---|"]
         out += [f"| {v['bit']} | {v['name']} | {v['doc']} |" for v in flags["values"]]
         out.append("")
     return "\n".join(out)

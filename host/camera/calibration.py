@@ -38,7 +38,7 @@ class Geometry:
         return self.focal_px * self.baseline_m / depth_m
 
     @classmethod
-    def minoru_default(cls, width: int, height: int) -> "Geometry":
+    def minoru_default(cls, width: int, height: int) -> Geometry:
         scale = width / 320.0
         print(f"no --calib: assuming the Minoru's nominal geometry, focal length "
               f"{MINORU_FOCAL_PX_320 * scale:.0f} px at {width}x{height} and baseline "
@@ -74,7 +74,7 @@ class Calibration:
         write_text_atomic(path, fs.releaseAndGetString())
 
     @classmethod
-    def load(cls, path: str | os.PathLike[str]) -> "Calibration":
+    def load(cls, path: str | os.PathLike[str]) -> Calibration:
         if not Path(path).is_file():
             raise CameraError(f"{path}: no such calibration file")
         try:

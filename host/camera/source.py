@@ -66,7 +66,7 @@ class StereoSource:
     def close(self) -> None:
         pass
 
-    def __enter__(self) -> "StereoSource":
+    def __enter__(self) -> StereoSource:
         return self
 
     def __exit__(self, *exc: object) -> None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import signal
 import sys
 import tempfile
@@ -29,6 +30,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(run=run)
 
 
+def _interrupt(*_: object) -> None:
+    raise KeyboardInterrupt
+
+
 def _check_rate(name: str, value: float) -> None:
     if not 0.0 <= value < 1.0:
         raise HostError(f"--{name} must be in [0, 1), got {value}")
@@ -37,7 +42,7 @@ def _check_rate(name: str, value: float) -> None:
 def run(args: argparse.Namespace) -> int:
     _check_rate("drop", args.drop)
     _check_rate("corrupt", args.corrupt)
-    signal.signal(signal.SIGTERM, lambda *_: (_ for _ in ()).throw(KeyboardInterrupt))
+    signal.signal(signal.SIGTERM, _interrupt)  # kill ends it like Ctrl-C
     if args.simavr:
         return _run_simavr(args)
     faults = Faults(args.drop, args.corrupt, args.delay_ms,
@@ -48,7 +53,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"emulating the robot on {service.path} (Ctrl-C to stop)", file=sys.stderr)
         last = None
         t_end = None if args.duration is None else time.monotonic() + args.duration
-        try:
+        with contextlib.suppress(KeyboardInterrupt):
             while t_end is None or time.monotonic() < t_end:
                 motors = emu.motors()
                 if motors != last:
@@ -56,8 +61,6 @@ def run(args: argparse.Namespace) -> int:
                           f"right {motors[1]:5d} permille", file=sys.stderr, flush=True)
                     last = motors
                 time.sleep(0.01)
-        except KeyboardInterrupt:
-            pass
     return 0
 
 
@@ -73,8 +76,6 @@ def _run_simavr(args: argparse.Namespace) -> int:
             print(sim.path, flush=True)
             print(f"the firmware ELF runs in simavr on {sim.path} (Ctrl-C to stop)",
                   file=sys.stderr)
-            try:
+            with contextlib.suppress(KeyboardInterrupt):
                 time.sleep(args.duration if args.duration is not None else 1e9)
-            except KeyboardInterrupt:
-                pass
     return 0

@@ -119,7 +119,9 @@ def _servo(args, params, source, link, geometry, world, clock) -> int:
         marker_radius_m=args.marker_radius_cm / 100 if args.marker_radius_cm else None)
     target = servo.reference()
     z = geometry.depth_m(target.disparity)
-    tol = args.tolerance_cm / 100 * target.disparity ** 2 / (geometry.focal_px * geometry.baseline_m)
+    # one px of disparity is about Z^2 / (f B) of depth there: d^2 / (f B) px per metre
+    tol = args.tolerance_cm / 100 * target.disparity ** 2 / (
+        geometry.focal_px * geometry.baseline_m)
     servo.control = ControlConfig(**{**servo.control.__dict__, "tolerance_px": tol})
     servo.controller.cfg = servo.control
     print(f"target: nearest object at disparity {target.disparity:.2f} px ({z:.3f} m), "

@@ -89,7 +89,7 @@ def run(args: argparse.Namespace) -> int:
             "method": args.method, "space": args.space, "seed": args.seed,
             "scenes": [s.name for s in tuned_on], "bad": round(result.best_bad, 4),
             "evaluations": result.evaluations,
-            "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")})
+            "date": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")})
     if args.plot:
         from host.tuning.plot import plot
 

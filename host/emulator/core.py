@@ -17,8 +17,8 @@ from host.errors import HostError
 SOURCES = [FIRMWARE / "core" / "robot.c", FIRMWARE / "core" / "drive.c",
            FIRMWARE / "core" / "link.c", FIRMWARE / "emu" / "board.c",
            ROOT / "protocol" / "c" / "frame.c"]
-HEADERS = sorted((FIRMWARE / "core").glob("*.h")) + sorted((ROOT / "protocol" / "c").glob("*.h")) + [
-    FIRMWARE / "config.h"]
+HEADERS = [*sorted((FIRMWARE / "core").glob("*.h")),
+           *sorted((ROOT / "protocol" / "c").glob("*.h")), FIRMWARE / "config.h"]
 CACHE = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "stereo-servo"
 
 

@@ -3,6 +3,7 @@ faults, and a pseudo-terminal that any serial program can open as if it were the
 
 from __future__ import annotations
 
+import contextlib
 import os
 import random
 import select
@@ -142,7 +143,7 @@ class PtyService:
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, name="pty-emulator", daemon=True)
 
-    def start(self) -> "PtyService":
+    def start(self) -> PtyService:
         self._thread.start()
         return self
 
@@ -152,10 +153,8 @@ class PtyService:
         while not self._stop.is_set():
             ready, _, _ = select.select([self._master], [], [], 0.001)
             if ready:
-                try:
+                with contextlib.suppress(OSError):  # no client has the port open
                     emu.receive(os.read(self._master, 4096))
-                except OSError:
-                    pass  # no client has the port open
             if self.realtime:
                 now = (time.monotonic() - t0) * 1000
                 if now > emu.now_ms:
@@ -164,22 +163,18 @@ class PtyService:
                 emu.process()
             out = emu.transmit()
             if out:
-                try:
+                with contextlib.suppress(OSError):
                     os.write(self._master, out)
-                except OSError:
-                    pass
 
     def close(self) -> None:
         self._stop.set()
         if self._thread.is_alive():
             self._thread.join(timeout=2)
         for fd in (self._master, self._slave):
-            try:
+            with contextlib.suppress(OSError):
                 os.close(fd)
-            except OSError:
-                pass
 
-    def __enter__(self) -> "PtyService":
+    def __enter__(self) -> PtyService:
         return self.start()
 
     def __exit__(self, *exc: object) -> None:

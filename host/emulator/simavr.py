@@ -62,18 +62,18 @@ class Script:
     def __init__(self) -> None:
         self.lines: list[str] = []
 
-    def send(self, data: bytes) -> "Script":
+    def send(self, data: bytes) -> Script:
         self.lines.append(f"send {data.hex()}")
         return self
 
-    def message(self, seq: int, msg) -> "Script":
+    def message(self, seq: int, msg) -> Script:
         return self.send(encode_frame(seq, *pack(msg)))
 
-    def run_ms(self, ms: float) -> "Script":
+    def run_ms(self, ms: float) -> Script:
         self.lines.append(f"run {ms}")
         return self
 
-    def quiet(self, on: bool = True) -> "Script":
+    def quiet(self, on: bool = True) -> Script:
         self.lines.append(f"quiet {int(on)}")
         return self
 
@@ -124,7 +124,7 @@ class SimavrPty:
             self._proc.terminate()
             self._proc.wait(timeout=5)
 
-    def __enter__(self) -> "SimavrPty":
+    def __enter__(self) -> SimavrPty:
         return self
 
     def __exit__(self, *exc: object) -> None:

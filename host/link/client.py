@@ -12,7 +12,8 @@ from __future__ import annotations
 
 import random
 import time
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 import serial
 
@@ -49,7 +50,7 @@ class RobotLink:
 
     # ----------------------------------------------------------------------------- port I/O
 
-    def open(self) -> "RobotLink":
+    def open(self) -> RobotLink:
         try:
             self._ser = serial.serial_for_url(self.port, baudrate=self.baud, timeout=0.005,
                                               write_timeout=1.0)
@@ -180,7 +181,7 @@ class RobotLink:
             self._ser.close()
             self._ser = None
 
-    def __enter__(self) -> "RobotLink":
+    def __enter__(self) -> RobotLink:
         return self.open()
 
     def __exit__(self, *exc: object) -> None:

@@ -46,8 +46,9 @@ def unpack(msg_id: int, payload: bytes) -> Any:
     for f in fields(msg):
         lo, hi = cls.RANGES[f.name]
         if not lo <= getattr(msg, f.name) <= hi:
+            value = getattr(msg, f.name)
             raise ProtocolError(gen.Error.OUT_OF_RANGE,
-                                f"{cls.NAME}.{f.name} = {getattr(msg, f.name)} is outside {lo}..{hi}")
+                                f"{cls.NAME}.{f.name} = {value} is outside {lo}..{hi}")
     return msg
 
 

@@ -125,7 +125,7 @@ def find_markers(left: np.ndarray, right: np.ndarray, kind: str = "disc",
     pairs = []
     for a in found[0]:
         for b in found[1]:
-            if (abs(a.v - b.v) <= max_row_error and 0 < a.u - b.u
+            if (abs(a.v - b.v) <= max_row_error and a.u - b.u > 0
                     and abs(a.radius - b.radius) <= 0.3 * a.radius + 1):
                 pairs.append(MarkerPair(a, b))
     return pairs

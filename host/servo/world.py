@@ -91,7 +91,7 @@ class World:
     # ------------------------------------------------------------------------- geometry
 
     @classmethod
-    def for_size(cls, width: int, height: int, **kw) -> "World":
+    def for_size(cls, width: int, height: int, **kw) -> World:
         s = width / 320.0
         return cls(Geometry(426.0 * s, 0.060, width / 2, height / 2), (width, height), **kw)
 

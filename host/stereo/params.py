@@ -43,14 +43,14 @@ class MatcherParams:
     p2: int = 0
     mode: str = "sgbm"
 
-    def replace(self, **changes: Any) -> "MatcherParams":
+    def replace(self, **changes: Any) -> MatcherParams:
         return replace(self, **changes)
 
     def to_dict(self) -> dict[str, Any]:
         return {k: v for k, v in asdict(self).items() if v is not None}
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> "MatcherParams":
+    def from_dict(cls, data: dict[str, Any]) -> MatcherParams:
         known = {f.name for f in fields(cls)}
         unknown = sorted(set(data) - known)
         if unknown:
@@ -66,13 +66,13 @@ class MatcherParams:
                 raise HostError(f"matcher parameter {key} must be {want.__name__}, got {value!r}")
         return cls(**data)
 
-    def validate(self, width: int | None = None) -> "MatcherParams":
+    def validate(self, width: int | None = None) -> MatcherParams:
         """Check bounds; width (px) also bounds the disparity range. Returns self."""
         if self.matcher not in MATCHERS:
             raise HostError(f"unknown matcher {self.matcher!r} (choose from {', '.join(MATCHERS)})")
         if self.block_size < 1 or self.block_size % 2 == 0:
             raise HostError(f"window must be odd and positive, got {self.block_size}")
-        if self.block_size > 255 or (self.matcher == "opencv-bm" and not 5 <= self.block_size):
+        if self.block_size > 255 or (self.matcher == "opencv-bm" and not self.block_size >= 5):
             raise HostError(f"window {self.block_size} is out of range for {self.matcher}")
         if self.num_disparities < 1:
             raise HostError(f"num-disp must be positive, got {self.num_disparities}")
@@ -90,7 +90,8 @@ class MatcherParams:
         if self.median not in (0, 3, 5):
             raise HostError(f"median must be 0, 3 or 5, got {self.median}")
         if self.mode not in SGBM_MODES:
-            raise HostError(f"unknown SGBM mode {self.mode!r} (choose from {', '.join(SGBM_MODES)})")
+            raise HostError(f"unknown SGBM mode {self.mode!r} "
+                            f"(choose from {', '.join(SGBM_MODES)})")
         if width is not None:
             if self.block_size >= width:
                 raise HostError(f"window {self.block_size} is too large for an image "

@@ -56,7 +56,7 @@ class Objective:
 
     @classmethod
     def on_scenes(cls, scenes: Sequence[Scene], params_of: Callable[[State], MatcherParams],
-                  rho: float = 1.0, workers: int = 1) -> "Objective":
+                  rho: float = 1.0, workers: int = 1) -> Objective:
         for s in scenes:
             if s.gt is None:
                 raise HostError(f"scene {s.name} has no ground truth to tune against")

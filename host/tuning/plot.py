@@ -24,7 +24,8 @@ def plot(result: TuneResult, path: str | os.PathLike[str], max_rows: int = 30) -
 
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 5), width_ratios=[1.3, 1])
     it = np.arange(1, len(result.history) + 1)
-    ax1.plot(it, [b for _, b in result.history], "o-", ms=3, lw=1, label="bad % at the visited state")
+    ax1.plot(it, [b for _, b in result.history], "o-", ms=3, lw=1,
+             label="bad % at the visited state")
     ax1.step(it, result.best_so_far(), where="post", lw=2, label="best so far")
     ax1.set(xlabel="iteration", ylabel="bad pixels (%)",
             title=f"{result.method} on {result.space.name}: best {result.best_bad:.2f}% at "

@@ -11,7 +11,7 @@ import pytest
 from host.camera.calibration import Calibration, Rectifier, calibrate, find_board
 from host.camera.source import CameraError
 
-from .boards import BASELINE_MM, BOARD, K, R_RIGHT, SQUARE_MM, views
+from .boards import BASELINE_MM, BOARD, R_RIGHT, SQUARE_MM, K, views
 
 
 @pytest.fixture(scope="module")
@@ -42,7 +42,7 @@ def test_rectified_pairs_have_rows_aligned_below_half_a_pixel(calibrated) -> Non
     inside = [(p[:, :2] / p[:, 2:]) for p in (left_px, right_px)]
     ul = cv2.undistortPoints(inside[0].reshape(-1, 1, 2), m["K1"], m["D1"], R=m["R1"], P=m["P1"])
     ur = cv2.undistortPoints(inside[1].reshape(-1, 1, 2), m["K2"], m["D2"], R=m["R2"], P=m["P2"])
-    seen = np.all([(0 <= q[:, 0]) & (q[:, 0] < 640) & (0 <= q[:, 1]) & (q[:, 1] < 480)
+    seen = np.all([(q[:, 0] >= 0) & (q[:, 0] < 640) & (q[:, 1] >= 0) & (q[:, 1] < 480)
                    for q in inside], axis=0)
     assert seen.sum() > 200
     dy = (ul - ur).reshape(-1, 2)[seen, 1]

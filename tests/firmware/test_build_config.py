@@ -41,7 +41,8 @@ def test_same_mcu_and_clock(make_config, pio) -> None:
 
 
 def test_same_sources(make_config, pio) -> None:
-    make_sources = {str((FW / s).resolve().relative_to(ROOT)) for s in make_config["SOURCES"].split()}
+    make_sources = {str((FW / s).resolve().relative_to(ROOT))
+                    for s in make_config["SOURCES"].split()}
     pio_sources = set(re.findall(r"\+<([^>]+)>", pio["env"]["build_src_filter"]))
     assert pio_sources == make_sources
 

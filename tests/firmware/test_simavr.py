@@ -8,10 +8,9 @@ from pathlib import Path
 
 import pytest
 
+from host.emulator.simavr import CYCLES_PER_BYTE, F_CPU, Script, run
 from host.link import protocol_gen as gen
 from host.link.messages import describe, unpack
-
-from host.emulator.simavr import CYCLES_PER_BYTE, F_CPU, Script, run
 
 MS = F_CPU // 1000
 ROOT = Path(__file__).resolve().parents[2]
@@ -140,7 +139,7 @@ def expected_reply(frame: dict) -> str:
     if text.startswith("error"):
         return "NACK " + text.split()[1]
     name = text.split()[0]
-    cls = next(c for c in gen.MESSAGES.values() if c.NAME == name)
+    cls = next(c for c in gen.MESSAGES.values() if name == c.NAME)
     if cls.DIRECTION == "robot_to_host":
         return "NACK WRONG_DIRECTION"
     return {"HELLO": "HELLO_REPLY", "GET_STATUS": "STATUS"}.get(name, "ACK")

@@ -10,7 +10,6 @@ import time
 import pytest
 
 from host.emulator.emulator import Emulator, Faults, PtyService
-from host.link import protocol_gen as gen
 from host.link.client import LinkError, RobotLink
 
 

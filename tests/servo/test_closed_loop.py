@@ -16,10 +16,7 @@ def test_robot_ends_at_the_nearest_objects_depth(start: float) -> None:
         rows = sim.servo.rows
         assert sim.source.t <= 20.0 and sim.servo.held_for(1.0), "did not settle within 20 s"
         assert abs(sim.world.robot.z_m - box) <= 0.03
-        if start < box:
-            overshoot = max(sim.depths) - box
-        else:
-            overshoot = box - min(sim.depths)
+        overshoot = max(sim.depths) - box if start < box else box - min(sim.depths)
         assert overshoot <= 0.10, f"overshoot {overshoot:.3f} m"
         assert (rows[-1].left, rows[-1].right) == (0, 0)
         assert sim.emulator.motors() == (0, 0)
