@@ -181,33 +181,29 @@ def qlearning(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
     return _result("qlearning", space, obj, history, dict(q))
 
 
-def grid(obj: Run, space: Space, on_step: Callable[[], None] | None = None) -> TuneResult:
+def _in_batches(obj: Run, states: list[State], on_step: Callable[[], None] | None,
+                batch: int = 32) -> list[tuple[State, float]]:
+    """Evaluate states in order, a batch at a time (in parallel when the objective has
+    workers); one history entry per state."""
     history = []
-    states = space.states()
-    chunk = 32
-    for i in range(0, len(states), chunk):
-        part = states[i:i + chunk]
+    for i in range(0, len(states), batch):
+        part = states[i:i + batch]
         for s, bad in zip(part, obj.many(part)):
             history.append((s, bad))
             if on_step:
                 on_step()
-    return _result("grid", space, obj, history)
+    return history
+
+
+def grid(obj: Run, space: Space, on_step: Callable[[], None] | None = None) -> TuneResult:
+    return _result("grid", space, obj, _in_batches(obj, space.states(), on_step))
 
 
 def random_search(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
                   on_step: Callable[[], None] | None = None) -> TuneResult:
     states = space.states()
-    order = rng.permutation(len(states))[:iterations]
-    picked = [states[i] for i in order]
-    history = []
-    chunk = 32
-    for i in range(0, len(picked), chunk):
-        part = picked[i:i + chunk]
-        for s, bad in zip(part, obj.many(part)):
-            history.append((s, bad))
-            if on_step:
-                on_step()
-    return _result("random", space, obj, history)
+    picked = [states[i] for i in rng.permutation(len(states))[:iterations]]
+    return _result("random", space, obj, _in_batches(obj, picked, on_step))
 
 
 def tune(method: str, obj: Objective, space: Space, iterations: int, seed: int,
