@@ -91,3 +91,14 @@ def test_an_interrupted_run_leaves_no_params_file(tmp_path: Path) -> None:
     out.write_text("[matcher]\nblock_size = 7\n")
     r = _run("--iterations", "0", "--out", str(out))
     assert r.returncode == 2 and out.read_text() == "[matcher]\nblock_size = 7\n"
+
+
+def test_parallel_workers_give_the_same_result_as_one_process(scene) -> None:
+    space = make_space("window", MatcherParams(num_disparities=32), odd_range("5:11"))
+    one = Objective.on_scenes([scene], space.params)
+    two = Objective.on_scenes([scene], space.params, workers=2)
+    try:
+        a, b = tune("grid", one, space, 0, 0), tune("grid", two, space, 0, 0)
+    finally:
+        two.close()
+    assert a.history == b.history and b.evaluations == space.size
