@@ -36,12 +36,6 @@ class SimRun:
     def frames(self) -> list[Frame]:
         return FrameDecoder().feed(bytes(b for _, b in self.tx))
 
-    def frames_with_cycles(self) -> list[tuple[int, Frame]]:
-        dec, out = FrameDecoder(), []
-        for cycle, b in self.tx:
-            out += [(cycle, f) for f in dec.feed(bytes([b]))]
-        return out
-
     def settled(self) -> list[Pwm]:
         """Output changes with the transients dropped: the firmware writes OCR1A, then OCR1B a
         few cycles later; a state that lasted under 100 cycles is not a state."""

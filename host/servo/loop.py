@@ -16,8 +16,6 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
-import numpy as np
-
 from host.camera.calibration import Geometry
 from host.camera.source import CameraError, StereoSource
 from host.servo.controller import Command, ControlConfig, Controller, Observation
@@ -142,6 +140,3 @@ class Servo:
                 return True
         return False
 
-
-def depth_of(geometry: Geometry, disparity_px: float) -> float:
-    return geometry.depth_m(disparity_px) if disparity_px > 0 else float(np.inf)
