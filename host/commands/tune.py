@@ -31,6 +31,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--workers", type=int, default=1, help="parallel evaluation processes")
     p.add_argument("--windows", default="5:41", help="odd window sizes lo:hi (window space)")
     p.add_argument("--step", type=int, default=1, help="action step in values of a parameter")
+    p.add_argument("--alpha", type=float, help="qlearning: learning rate (default 0.5)")
+    p.add_argument("--gamma", type=float, help="discount (default: paper 0.8, qlearning 0.9)")
+    p.add_argument("--epsilon", type=float,
+                   help="exploration (paper 0.2; qlearning 0.3 at the start, decaying)")
+    p.add_argument("--episodes", type=int, help="qlearning: episodes (default 20)")
     p.add_argument("--tune-on", type=int, metavar="N",
                    help="tune on the first N scenes, report the others as held out")
     p.add_argument("--scale", type=float, help="ground-truth scale for 2001/2003 layouts")
@@ -72,12 +77,27 @@ def run(args: argparse.Namespace) -> int:
                         f"{len(space.dims)} (use --method qlearning)")
     for s in space.states():  # every state must be a valid matcher on these images
         space.params(s).validate(width=min(sc.left.shape[1] for sc in scenes))
+    hyper = {k: v for k, v in (("gamma", args.gamma), ("epsilon", args.epsilon),
+                               ("alpha", args.alpha), ("episodes", args.episodes))
+             if v is not None}
+    if args.method in ("paper", "qlearning"):
+        hyper["step"] = args.step
+    if args.method == "paper" and ({"alpha", "episodes"} & set(hyper)):
+        raise HostError("--alpha and --episodes belong to --method qlearning")
+    if args.method in ("grid", "random") and set(hyper) - {"step"}:
+        raise HostError(f"--method {args.method} takes no learning parameters")
+    if args.step < 1 or (args.episodes is not None and args.episodes < 1):
+        raise HostError("--step and --episodes must be at least 1")
+    for name in ("alpha", "gamma", "epsilon"):
+        value = getattr(args, name)
+        if value is not None and not 0.0 <= value <= 1.0:
+            raise HostError(f"--{name} must be in [0, 1], got {value}")
     obj = Objective.on_scenes(tuned_on, space.params, workers=args.workers)
     total = space.size if args.method == "grid" else iterations
     bar = _progress(total, not args.json and sys.stderr.isatty())
     try:
         result = tune(args.method, obj, space, iterations, args.seed,
-                      on_step=bar.update if bar else None)
+                      on_step=bar.update if bar else None, **hyper)
     finally:
         obj.close()
         if bar:

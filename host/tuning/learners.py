@@ -154,7 +154,8 @@ def qlearning(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
     actions = space.actions
     opposite = [actions.index((d, -sign)) if d >= 0 else 0 for d, sign in actions]
     q: dict[State, np.ndarray] = defaultdict(lambda: np.zeros(len(actions)))
-    decay = (epsilon_final / epsilon) ** (1 / max(1, iterations - 1))
+    final = min(epsilon_final, epsilon)
+    decay = (final / epsilon) ** (1 / max(1, iterations - 1)) if epsilon > 0 else 1.0
     per_episode = -(-iterations // episodes)
     history: list[tuple[State, float]] = []
     states = space.states()

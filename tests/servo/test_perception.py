@@ -57,3 +57,20 @@ def test_marker_centres_within_half_a_pixel_on_noisy_renders(z: float, side: flo
     assert abs(pair.left.u - u) < 0.5 and abs(pair.left.v - v) < 0.5
     assert abs(pair.right.u - (u - d)) < 0.5
     assert abs(pair.disparity - d) < 0.25
+
+
+def test_aruco_marker_gives_the_disparity_of_its_two_views() -> None:
+    import cv2
+
+    tag = cv2.aruco.generateImageMarker(cv2.aruco.getPredefinedDictionary(cv2.aruco.DICT_4X4_50),
+                                        7, 60)
+    rng = np.random.default_rng(0)
+    base = rng.integers(90, 170, (240, 320), dtype=np.uint8)
+    left, right = base.copy(), base.copy()
+    padded = cv2.copyMakeBorder(tag, 10, 10, 10, 10, cv2.BORDER_CONSTANT, value=255)
+    left[90:170, 150:230] = padded
+    right[90:170, 130:210] = padded  # 20 px to the left in the right view
+    pair = find_marker(left, right, kind="aruco")
+    assert pair is not None and pair.disparity == pytest.approx(20.0, abs=0.05)
+    assert pair.left.u == pytest.approx(189.5, abs=0.6) and pair.left.v == pytest.approx(129.5,
+                                                                                         abs=0.6)

@@ -73,6 +73,8 @@ def _run(*argv: str) -> subprocess.CompletedProcess[str]:
     (["--iterations", "0"], "at least 1"),
     (["--space", "sad"], "tunes one parameter"),
     (["--windows", "4:10"], "odd bounds"),
+    (["--alpha", "0.5"], "belong to --method qlearning"),
+    (["--method", "grid", "--gamma", "0.5"], "takes no learning parameters"),
 ])
 def test_bad_input_is_a_one_line_error(argv: list[str], message: str) -> None:
     r = _run(*argv)
@@ -102,3 +104,13 @@ def test_parallel_workers_give_the_same_result_as_one_process(scene) -> None:
     finally:
         two.close()
     assert a.history == b.history and b.evaluations == space.size
+
+
+def test_learning_parameters_reach_the_learner(capsys) -> None:
+    argv = ["tune", "--method", "qlearning", "--iterations", "12", "--windows", "7:13",
+            "--json", "--seed", "2"]
+    assert main(argv + ["--epsilon", "0.0", "--episodes", "1"]) == 0
+    greedy = json.loads(capsys.readouterr().out)["history"]
+    assert main(argv + ["--epsilon", "1.0", "--episodes", "1"]) == 0
+    random_walk = json.loads(capsys.readouterr().out)["history"]
+    assert greedy != random_walk
