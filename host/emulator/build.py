@@ -35,6 +35,7 @@ def simavr_harness(out_dir: Path) -> Path:
         raise HostError("simavr headers not found: install simavr and libsimavr-dev")
     exe = out_dir / "simavr-harness"
     subprocess.run(["gcc", "-std=gnu11", "-O2", "-Wall", "-Wextra", "-Werror",
-                    f"-I{SIMAVR_INCLUDE}", str(FIRMWARE / "simavr" / "harness.c"), "-lsimavr",
+                    f"-I{SIMAVR_INCLUDE}", f"-I{ROOT / 'protocol' / 'c'}",
+                    str(FIRMWARE / "simavr" / "harness.c"), "-lsimavr",
                     "-o", str(exe)], check=True)
     return exe

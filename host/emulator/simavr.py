@@ -7,11 +7,12 @@ import subprocess
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from host.link import protocol_gen as gen
 from host.link.frame import Frame, FrameDecoder, encode_frame
 from host.link.messages import pack
 
 F_CPU = 16_000_000
-CYCLES_PER_BYTE = 10 * F_CPU // 115200  # the harness feeds bytes at the host's line rate
+CYCLES_PER_BYTE = 10 * F_CPU // gen.BAUD  # the harness feeds bytes at the host's line rate
 
 
 @dataclass

@@ -4,7 +4,7 @@
  *   harness FIRMWARE.elf --pty     real time, UART0 bridged to a pseudo-terminal
  *
  * Scripted commands, one a line:
- *   send HEX     queue bytes for UART0, delivered at 115200 baud once the UART says XON
+ *   send HEX     queue bytes for UART0, delivered at PROTO_BAUD once the UART says XON
  *   run MS       simulate MS milliseconds
  *   quiet 0|1    stop or start printing each "in" byte (counts are kept either way)
  * Events on stdout, times in CPU cycles since power-on:
@@ -28,8 +28,10 @@
 #include <simavr/sim_avr.h>
 #include <simavr/sim_elf.h>
 
+#include "protocol_gen.h"
+
 #define F_CPU 16000000UL
-#define CYCLES_PER_BYTE (10UL * F_CPU / 115200) /* the host's line: 10 bits a byte */
+#define CYCLES_PER_BYTE (10UL * F_CPU / PROTO_BAUD) /* the host's line: 10 bits a byte */
 
 /* ATmega328P data-space addresses (datasheet, register summary) */
 #define REG_PORTD 0x2B
