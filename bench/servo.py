@@ -29,7 +29,8 @@ def measure(size: tuple[int, int], params: MatcherParams, full_map: bool) -> tup
         # the simulated camera steps its own copy of the world; the robot here only answers
         source = SimSource(world, Emulator(line_rate=False), reference_frames=3)
         servo = Servo(source, link, params, world.geometry,
-                      ControlConfig(turn_s=world.motors.turn_seconds(400)), full_map=full_map)
+                      ControlConfig(turn_s=world.motors.turn_seconds(ControlConfig.turn_duty)),
+                      full_map=full_map)
         servo.reference()
         lat = []
         t_busy = 0.0

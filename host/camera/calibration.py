@@ -37,6 +37,11 @@ class Geometry:
     def disparity_px(self, depth_m: float) -> float:
         return self.focal_px * self.baseline_m / depth_m
 
+    def px_per_m(self, disparity_px: float) -> float:
+        """Depth resolution there: disparity change per metre of depth, d^2 / (f B) (one px of
+        disparity is Z^2 / (f B) of depth)."""
+        return disparity_px ** 2 / (self.focal_px * self.baseline_m)
+
     @classmethod
     def minoru_default(cls, width: int, height: int) -> Geometry:
         scale = width / 320.0

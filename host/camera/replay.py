@@ -33,8 +33,8 @@ def image_pairs(folder: Path) -> list[tuple[Path, Path]]:
 class ReplaySource(StereoSource):
     """Pairs from a folder (at fps, for timestamps) or from two videos (their own timestamps)."""
 
-    def __init__(self, path: Path, fps: float = 30.0, loop: bool = False) -> None:
-        self.fps, self.loop = fps, loop
+    def __init__(self, path: Path, fps: float = 30.0) -> None:
+        self.fps = fps
         self._index = 0
         self._videos = None
         if path.is_dir() and (path / "left.avi").exists() or str(path).count(",") == 1:
@@ -57,10 +57,8 @@ class ReplaySource(StereoSource):
                 out.append((img, v.get(cv2.CAP_PROP_POS_MSEC) / 1000))
             return StereoFrame(out[0][0], out[1][0], out[0][1], out[1][1])
         if self._index >= len(self._pairs):
-            if not self.loop:
-                return None
-            self._index = 0
-        left, right = self._pairs[self._index % len(self._pairs)]
+            return None
+        left, right = self._pairs[self._index]
         t = self._index / self.fps
         self._index += 1
         return StereoFrame(read_image(left), read_image(right), t, t)

@@ -112,18 +112,16 @@ def _sim(args, emulator):
 
 
 def _servo(args, params, source, link, geometry, world, clock) -> int:
-    turn_s = args.turn_s or (world.motors.turn_seconds(400) if world else 2.0)
+    turn_s = args.turn_s or (world.motors.turn_seconds(ControlConfig.turn_duty) if world
+                             else 2.0)
     servo = Servo(source, link, params, geometry, ControlConfig(
         max_duty=args.max_duty, min_duty=args.min_duty, mode=args.mode, turn_s=turn_s),
         marker=args.marker, clock=clock,
-        marker_radius_m=args.marker_radius_cm / 100 if args.marker_radius_cm else None)
+        marker_radius_m=args.marker_radius_cm / 100 if args.marker_radius_cm else None,
+        tolerance_m=args.tolerance_cm / 100)
     target = servo.reference()
     z = geometry.depth_m(target.disparity)
-    # one px of disparity is about Z^2 / (f B) of depth there: d^2 / (f B) px per metre
-    tol = args.tolerance_cm / 100 * target.disparity ** 2 / (
-        geometry.focal_px * geometry.baseline_m)
-    servo.control = ControlConfig(**{**servo.control.__dict__, "tolerance_px": tol})
-    servo.controller.cfg = servo.control
+    tol = servo.control.tolerance_px
     print(f"target: nearest object at disparity {target.disparity:.2f} px ({z:.3f} m), "
           f"{target.area} px; tolerance {tol:.3f} px = {args.tolerance_cm:g} cm there",
           file=sys.stderr)

@@ -11,6 +11,7 @@ Any exception leaves through the link's context manager, which sends STOP.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Callable
@@ -45,7 +46,8 @@ class Servo:
                  control: ControlConfig = ControlConfig(), marker: str = "disc",
                  reference_frames: int = 5, min_area: int | None = None, stale_s: float = 0.5,
                  clock: Callable[[], float] = time.monotonic, full_map: bool = False,
-                 max_mismatch_px: float = 1.5, marker_radius_m: float | None = 0.03) -> None:
+                 max_mismatch_px: float = 1.5, marker_radius_m: float | None = 0.03,
+                 tolerance_m: float | None = None) -> None:
         self.source, self.link, self.params = source, link, params
         self.geometry, self.control, self.marker = geometry, control, marker
         self.reference_frames, self.stale_s, self.clock = reference_frames, stale_s, clock
@@ -53,6 +55,7 @@ class Servo:
         self.full_map = full_map
         self.max_mismatch_px = max_mismatch_px
         self.marker_radius_m = marker_radius_m  # the disc's radius on the card; None: unknown
+        self.tolerance_m = tolerance_m  # hold band in depth; None: control.tolerance_px as is
         self.last_pair = None
         self.target: Target | None = None
         self.controller: Controller | None = None
@@ -72,7 +75,10 @@ class Servo:
             disps.append(compute_disparity(f.left, f.right, self.params))
             self.link.stop()  # keeps the link alive while the robot waits
         h, w = disps[0].shape
-        self.target, floor = reference_target(disps, self.min_area or (w * h) // 100)
+        self.target, _ = reference_target(disps, self.min_area or (w * h) // 100)
+        if self.tolerance_m is not None:
+            tol = self.tolerance_m * self.geometry.px_per_m(self.target.disparity)
+            self.control = dataclasses.replace(self.control, tolerance_px=tol)
         self.controller = Controller(self.target.disparity, self.control)
         return self.target
 

@@ -16,13 +16,9 @@ from host.stereo.scenes import Scene
 State = tuple[int, ...]
 
 
-def region_of(scene: Scene) -> str:
-    """The region scored: nonocc where the scene has that mask, else every GT-known pixel."""
-    return "nonocc" if "nonocc" in scene.masks else "all-known"
-
-
 def scene_bad(scene: Scene, params: MatcherParams, rho: float = 1.0) -> float:
-    """Bad % of params on one scene over region_of(scene)."""
+    """Bad % of params on one scene: over the nonocc region where the scene has that mask,
+    else over every pixel with known ground truth."""
     assert scene.gt is not None
     disp = compute_disparity(scene.left, scene.right, params)
     return evaluate(disp, scene.gt, scene.masks.get("nonocc"), rho).bad
@@ -49,9 +45,10 @@ class Objective:
     space), or any function of the state (synthetic landscapes in tests)."""
 
     def __init__(self, fn: Callable[[State], float], batch: Callable[[list[State]], list[float]]
-                 | None = None) -> None:
+                 | None = None, pool: ProcessPoolExecutor | None = None) -> None:
         self._fn = fn
         self._batch = batch
+        self._pool = pool  # the worker processes behind batch, shut down by close()
         self.cache: dict[State, float] = {}
 
     @classmethod
@@ -70,9 +67,7 @@ class Objective:
             assert pool is not None
             return list(pool.map(_worker_eval, [(params_of(s), rho) for s in states]))
 
-        obj = cls(lambda s: mean_bad(scenes, params_of(s), rho), batch if pool else None)
-        obj._pool = pool
-        return obj
+        return cls(lambda s: mean_bad(scenes, params_of(s), rho), batch if pool else None, pool)
 
     @property
     def evaluations(self) -> int:
@@ -91,6 +86,5 @@ class Objective:
         return [self(s) for s in states]
 
     def close(self) -> None:
-        pool = getattr(self, "_pool", None)
-        if pool is not None:
-            pool.shutdown()
+        if self._pool is not None:
+            self._pool.shutdown()

@@ -41,12 +41,11 @@ def simulation(start_depth: float, seed: int = 0, faults: Faults = Faults(),
     with PtyService(emulator, realtime=False) as service, \
             RobotLink(service.path, retries=retries, reply_timeout_s=0.05) as link:
         source = SimSource(world, emulator)
-        control = ControlConfig(turn_s=world.motors.turn_seconds(400), mode=mode)
-        servo = Servo(source, link, PARAMS, world.geometry, control, clock=source.clock)
+        control = ControlConfig(turn_s=world.motors.turn_seconds(ControlConfig.turn_duty),
+                                mode=mode)
+        servo = Servo(source, link, PARAMS, world.geometry, control, clock=source.clock,
+                      tolerance_m=0.01)
         servo.reference()
         z = world.geometry.depth_m(servo.target.disparity)
-        tol = 0.01 * servo.target.disparity ** 2 / (world.geometry.focal_px
-                                                    * world.geometry.baseline_m)
-        servo.controller.cfg = ControlConfig(**{**control.__dict__, "tolerance_px": tol})
         assert abs(z - world.nearest_box().z_m) < 0.02
         yield Sim(world, emulator, source, servo, [])
