@@ -10,32 +10,14 @@ buffer timestamps differ by more than max_skew_ms is dropped (the older frame is
 from __future__ import annotations
 
 from collections.abc import Callable
-from pathlib import Path
 from typing import Any
 
 import cv2
 
+from host.camera.discovery import resolve
 from host.camera.source import CameraError, StereoFrame, StereoSource
 
-MINORU_IDS = {("0ac8", "3410"), ("0ac8", "3420")}
 MODES = {(320, 240): 30, (640, 480): 15}
-SYSFS = Path("/sys/class/video4linux")
-
-
-def find_minoru(sysfs: Path = SYSFS) -> list[str]:
-    """/dev/video nodes of the Minoru's two sensors, by USB id or by name, in sysfs order."""
-    nodes = []
-    for dev in sorted(sysfs.glob("video*"), key=lambda p: int(p.name[5:] or 0)):
-        name = (dev / "name").read_text().strip() if (dev / "name").exists() else ""
-        usb = (dev / "device").resolve().parent
-        ids = tuple((usb / f).read_text().strip() if (usb / f).exists() else ""
-                    for f in ("idVendor", "idProduct"))
-        index = (dev / "index").read_text().strip() if (dev / "index").exists() else "0"
-        if index != "0":
-            continue  # a second node of one sensor is its metadata stream
-        if ids in MINORU_IDS or "minoru" in name.lower() or "vimicro" in name.lower():
-            nodes.append(f"/dev/{dev.name}")
-    return nodes
 
 
 def open_v4l2(device: str, width: int, height: int, fps: int) -> Any:
@@ -55,7 +37,7 @@ class MinoruSource(StereoSource):
     """Pairs from the Minoru; devices, swap and the capture factory can be overridden."""
 
     def __init__(self, size: tuple[int, int] = (320, 240), devices: tuple[str, str] | None = None,
-                 swap: bool = False, max_skew_ms: float | None = None,
+                 swap: bool = False, max_skew_ms: float | None = None, spec: str = "minoru",
                  open_capture: Callable[[str, int, int, int], Any] = open_v4l2) -> None:
         if size not in MODES:
             raise CameraError(f"the Minoru streams {', '.join(f'{w}x{h}' for w, h in MODES)} "
@@ -63,11 +45,8 @@ class MinoruSource(StereoSource):
         self.size, self.fps = size, MODES[size]
         self.max_skew_ms = 0.5e3 / self.fps if max_skew_ms is None else max_skew_ms
         if devices is None:
-            found = find_minoru()
-            if len(found) < 2:
-                raise CameraError("no Minoru found (looked for USB 0ac8:3410/3420 under "
-                                  f"{SYSFS}); give the two devices with --devices L,R")
-            devices = (found[0], found[1])
+            left, right = resolve(spec).nodes
+            devices = (left, right)
         if swap:
             devices = (devices[1], devices[0])
         self.devices = devices

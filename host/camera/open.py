@@ -14,7 +14,8 @@ from host.errors import HostError
 def add_camera_options(p: argparse.ArgumentParser, sim: bool = False) -> None:
     g = p.add_argument_group("camera")
     g.add_argument("--camera", default="minoru",
-                   help="minoru, replay:DIR (left_*/right_* images or left.avi/right.avi)"
+                   help="minoru, minoru:USB-PORT (host cameras lists them), replay:DIR "
+                        "(left_*/right_* images or left.avi/right.avi)"
                         + (", or sim" if sim else ""))
     g.add_argument("--size", default="320x240", help="Minoru mode: 320x240 (30 fps) or "
                                                      "640x480 (15 fps)")
@@ -34,14 +35,15 @@ def parse_size(text: str) -> tuple[int, int]:
 def open_source(args: argparse.Namespace) -> StereoSource:
     """The source args.camera names (not sim), with rectification when --calib is given."""
     spec = args.camera
-    if spec == "minoru":
+    if spec == "minoru" or spec.startswith("minoru:"):
         devices = None
         if args.devices:
             parts = args.devices.split(",")
             if len(parts) != 2:
                 raise CameraError(f"--devices needs LEFT,RIGHT, got {args.devices!r}")
             devices = (parts[0], parts[1])
-        source: StereoSource = MinoruSource(parse_size(args.size), devices, args.swap)
+        source: StereoSource = MinoruSource(parse_size(args.size), devices, args.swap,
+                                               spec=spec)
     elif spec.startswith("replay:"):
         from pathlib import Path
 

@@ -2,15 +2,14 @@
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import cv2
 import numpy as np
 import pytest
 
-from host.camera import minoru
-from host.camera.minoru import MinoruSource, find_minoru
+from host.camera import discovery
+from host.camera.minoru import MinoruSource
 from host.camera.replay import ReplaySource
 from host.camera.source import CameraError
 from host.cli import main
@@ -66,27 +65,11 @@ def test_minoru_swap_exchanges_the_devices(tmp_path: Path) -> None:
 
 
 def test_minoru_not_found_and_unsupported_mode(tmp_path: Path, monkeypatch) -> None:
-    monkeypatch.setattr(minoru, "SYSFS", tmp_path)
-    with pytest.raises(CameraError, match="no Minoru found"):
+    monkeypatch.setattr(discovery, "SYSFS", tmp_path)
+    with pytest.raises(CameraError, match="no camera minoru found"):
         MinoruSource()
     with pytest.raises(CameraError, match="not 640x360"):
         MinoruSource((640, 360), devices=("a", "b"))
-
-
-def test_find_minoru_reads_sysfs(tmp_path: Path) -> None:
-    usb = tmp_path / "devices" / "1-1"
-    for n, pid in ((0, "3410"), (2, "3420")):
-        iface = usb / f"sensor{n}" / "1-1:1.0"
-        iface.mkdir(parents=True)
-        (iface.parent / "idVendor").write_text("0ac8\n")
-        (iface.parent / "idProduct").write_text(pid + "\n")
-        for index in (0, 1):
-            dev = tmp_path / f"video{n + index}"
-            dev.mkdir()
-            (dev / "name").write_text("Vimicro USB2.0 PC Camera\n")
-            (dev / "index").write_text(f"{index}\n")
-            os.symlink(iface, dev / "device")
-    assert find_minoru(tmp_path) == ["/dev/video0", "/dev/video2"]
 
 
 def test_a_vanished_camera_is_a_clear_error() -> None:
