@@ -1,27 +1,45 @@
-"""Open the stereo source a command line names: minoru, or replay:PATH; with --calib applied."""
+"""Open the stereo source a command line names (minoru, sbs, replay), check that left is left,
+and apply --calib."""
 
 from __future__ import annotations
 
 import argparse
+import sys
+from pathlib import Path
 
 from host.camera.calibration import Calibration, Rectifier
+from host.camera.live import LiveSource
+from host.camera.lr_check import CHECKS, handedness
 from host.camera.minoru import MinoruSource
 from host.camera.replay import ReplaySource
+from host.camera.sbs import SideBySideSource
 from host.camera.source import CameraError, StereoSource
+from host.camera.stamps import STAMPS
 from host.errors import HostError
 
 
 def add_camera_options(p: argparse.ArgumentParser, sim: bool = False) -> None:
     g = p.add_argument_group("camera")
     g.add_argument("--camera", default="minoru",
-                   help="minoru, minoru:USB-PORT (host cameras lists them), replay:DIR "
-                        "(left_*/right_* images or left.avi/right.avi)"
-                        + (", or sim" if sim else ""))
-    g.add_argument("--size", default="320x240", help="Minoru mode: 320x240 (30 fps) or "
-                                                     "640x480 (15 fps)")
-    g.add_argument("--devices", metavar="LEFT,RIGHT", help="the two /dev/video nodes")
-    g.add_argument("--swap", action="store_true", help="the Minoru's left and right are swapped")
-    g.add_argument("--calib", metavar="CALIB.yml", help="rectify with this calibration")
+                   help="minoru or minoru:USB-PORT; sbs, sbs:USB-PORT or sbs:/dev/videoN (a "
+                        "side-by-side camera); replay:DIR (left_*/right_* images or "
+                        "left.avi/right.avi)" + ("; or sim" if sim else "")
+                        + ". host cameras lists what is plugged in")
+    g.add_argument("--size", default="320x240",
+                   help="size of each view: the Minoru streams 320x240 (30 fps) or 640x480 "
+                        "(15 fps); a side-by-side camera what host cameras lists, halved")
+    g.add_argument("--devices", metavar="LEFT,RIGHT", help="the Minoru's two /dev/video nodes")
+    g.add_argument("--swap", action="store_true", help="the camera's left and right are swapped")
+    g.add_argument("--swap-check", choices=CHECKS, default="refuse",
+                   help="at start, check that left is left (median disparity sign): refuse a "
+                        "swapped pair, swap it (auto), or do not check (off)")
+    g.add_argument("--timestamps", choices=STAMPS, default="auto",
+                   help="capture times: the driver's buffer stamps, the grab time, or auto")
+    g.add_argument("--no-lock", dest="lock", action="store_false",
+                   help="leave exposure, gain and white balance on auto")
+    g.add_argument("--calib", metavar="CALIB.yml",
+                   help="rectify with this calibration (host calibrate --out), or "
+                        "LEFT.yaml,RIGHT.yaml (ROS camera_info)")
 
 
 def parse_size(text: str) -> tuple[int, int]:
@@ -32,24 +50,63 @@ def parse_size(text: str) -> tuple[int, int]:
     return w, h
 
 
+def _live(args: argparse.Namespace) -> LiveSource:
+    spec, size = args.camera, parse_size(args.size)
+    options = {"swap": args.swap, "lock": args.lock, "stamps": args.timestamps}
+    if spec == "sbs" or spec.startswith("sbs:"):
+        if args.devices:
+            raise HostError("--devices is for the Minoru; name a side-by-side camera with "
+                            "--camera sbs:/dev/videoN")
+        return SideBySideSource(size, spec, **options)
+    devices = None
+    if args.devices:
+        parts = args.devices.split(",")
+        if len(parts) != 2:
+            raise CameraError(f"--devices needs LEFT,RIGHT, got {args.devices!r}")
+        devices = (parts[0], parts[1])
+    return MinoruSource(size, devices, spec=spec, **options)
+
+
+def check_left_right(source: LiveSource, policy: str, frames: int = 3) -> str:
+    """Look at a few pairs; refuse (CameraError naming --swap) or swap a pair whose left and
+    right are exchanged. Returns what was found, one line."""
+    h = None
+    for _ in range(frames):
+        frame = source.read()
+        if frame is None:
+            raise CameraError("the camera ended before the left/right check")
+        h = handedness(frame.left, frame.right)
+        if h.conclusive:
+            break
+    assert h is not None
+    seen = f"median disparity {h.median_px:+.1f} px over {h.pixels} textured pixels"
+    if not h.conclusive:
+        return f"left/right not checked: too little near texture in view ({seen})"
+    if not h.swapped:
+        return f"left/right check passed: {seen}"
+    if policy == "auto":
+        source.swap_views()
+        return f"left and right were swapped ({seen}): swapped them back"
+    fix = "drop --swap" if source.swapped else "pass --swap"
+    raise CameraError(f"left and right look swapped ({seen}): {fix}, or --swap-check auto to "
+                      f"swap them at start")
+
+
 def open_source(args: argparse.Namespace) -> StereoSource:
     """The source args.camera names (not sim), with rectification when --calib is given."""
     spec = args.camera
-    if spec == "minoru" or spec.startswith("minoru:"):
-        devices = None
-        if args.devices:
-            parts = args.devices.split(",")
-            if len(parts) != 2:
-                raise CameraError(f"--devices needs LEFT,RIGHT, got {args.devices!r}")
-            devices = (parts[0], parts[1])
-        source: StereoSource = MinoruSource(parse_size(args.size), devices, args.swap,
-                                               spec=spec)
-    elif spec.startswith("replay:"):
-        from pathlib import Path
-
-        source = ReplaySource(Path(spec[len("replay:"):]))
+    if spec.startswith("replay:"):
+        source: StereoSource = ReplaySource(Path(spec[len("replay:"):]))
+    elif spec.split(":")[0] in ("minoru", "sbs"):
+        source = _live(args)
     else:
-        raise HostError(f"unknown camera {spec!r} (minoru or replay:DIR)")
-    if args.calib:
-        source.rectify = Rectifier(Calibration.load(args.calib))
+        raise HostError(f"unknown camera {spec!r} (minoru, sbs or replay:DIR)")
+    try:
+        if args.calib:
+            source.rectify = Rectifier(Calibration.load(args.calib))
+        if isinstance(source, LiveSource) and args.swap_check != "off":
+            print(f"camera: {check_left_right(source, args.swap_check)}", file=sys.stderr)
+    except BaseException:
+        source.close()
+        raise
     return source

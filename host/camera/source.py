@@ -45,6 +45,7 @@ class StereoSource:
     """Base of every source: read() gives the next rectified pair or None at the end."""
 
     rectify: Rectify | None = None
+    _skews_ms: list[float] | None = None
 
     def _read(self) -> StereoFrame | None:
         raise NotImplementedError
@@ -57,7 +58,18 @@ class StereoSource:
             raise CameraError(f"left and right frames differ in size: "
                               f"{frame.left.shape[1]}x{frame.left.shape[0]} vs "
                               f"{frame.right.shape[1]}x{frame.right.shape[0]}")
+        if self._skews_ms is None:
+            self._skews_ms = []
+        self._skews_ms.append(frame.skew_ms)
         return self.rectify(frame) if self.rectify else frame
+
+    def skew_summary(self) -> str:
+        """Left/right capture-time skew over the pairs read so far (ms)."""
+        s = sorted(self._skews_ms or [])
+        if not s:
+            return "no pairs read"
+        return (f"left/right skew over {len(s)} pairs: median {s[len(s) // 2]:.1f} ms, "
+                f"max {s[-1]:.1f} ms")
 
     def __iter__(self) -> Iterator[StereoFrame]:
         while (frame := self.read()) is not None:

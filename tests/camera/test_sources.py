@@ -28,14 +28,15 @@ def _video(path: Path, fps: float, n: int, size=(320, 240)) -> None:
 
 def _files(left: Path, right: Path):
     paths = {"L": str(left), "R": str(right)}
-    return lambda device, w, h, fps: cv2.VideoCapture(paths[device])
+    return lambda device: cv2.VideoCapture(paths[device])
 
 
 def test_minoru_grabs_both_then_retrieves_and_pairs_in_time(tmp_path: Path) -> None:
     _video(tmp_path / "l.avi", 30, 30)
     _video(tmp_path / "r.avi", 30, 30)
     src = MinoruSource(devices=("L", "R"), open_capture=_files(tmp_path / "l.avi",
-                                                               tmp_path / "r.avi"))
+                                                               tmp_path / "r.avi"),
+                       lock=False, stamps="driver")  # the files' times stand in for the driver's
     frames = [src.read() for _ in range(30)]
     with pytest.raises(CameraError, match="stopped delivering"):  # a camera never just ends
         src.read()
@@ -47,7 +48,8 @@ def test_minoru_drops_pairs_whose_skew_exceeds_the_bound(tmp_path: Path) -> None
     _video(tmp_path / "l.avi", 30, 40)
     _video(tmp_path / "r.avi", 15, 20)  # the right sensor delivers half as often
     src = MinoruSource(devices=("L", "R"), open_capture=_files(tmp_path / "l.avi",
-                                                               tmp_path / "r.avi"))
+                                                               tmp_path / "r.avi"),
+                       lock=False, stamps="driver")  # the files' times stand in for the driver's
     frames = []
     with pytest.raises(CameraError):  # the left stream ends first: a clean error, not a hang
         for f in src:
@@ -60,7 +62,7 @@ def test_minoru_swap_exchanges_the_devices(tmp_path: Path) -> None:
     _video(tmp_path / "l.avi", 30, 3, (320, 240))
     _video(tmp_path / "r.avi", 30, 3, (320, 240))
     src = MinoruSource(devices=("L", "R"), swap=True,
-                       open_capture=_files(tmp_path / "l.avi", tmp_path / "r.avi"))
+                       open_capture=_files(tmp_path / "l.avi", tmp_path / "r.avi"), lock=False)
     assert src.devices == ("R", "L")
 
 
@@ -74,13 +76,20 @@ def test_minoru_not_found_and_unsupported_mode(tmp_path: Path, monkeypatch) -> N
 
 def test_a_vanished_camera_is_a_clear_error() -> None:
     class Gone:
+        def get(self, prop: int) -> float:
+            return -1.0
+
+        def set(self, prop: int, value: float) -> bool:
+            return False
+
         def grab(self) -> bool:
             return False
 
         def release(self) -> None:
             pass
 
-    src = MinoruSource(devices=("/dev/video0", "/dev/video2"), open_capture=lambda *a: Gone())
+    src = MinoruSource(devices=("/dev/video0", "/dev/video2"), open_capture=lambda d: Gone(),
+                       lock=False)
     with pytest.raises(CameraError, match="/dev/video0 stopped delivering frames"):
         src.read()
 
