@@ -1,25 +1,30 @@
-"""Stereo calibration from chessboard pairs, rectification maps, and the camera geometry.
+"""Stereo calibration from chessboard pairs (with badly fitting views rejected), the rectified
+geometry, and rectification maps.
 
-Calibration files are OpenCV FileStorage YAML with image_size, K1 D1 K2 D2 R T E F R1 R2 P1 P2 Q,
-rms (px), epipolar_rms (px, row error of rectified corners) and baseline_mm.
+Matrices keep the names of OpenCV's stereo_calib sample: M1 D1 M2 D2 (intrinsics), R T E F
+(right camera from left: X_r = R X_l + T, T in the units of --square, mm), R1 R2 P1 P2 Q
+(rectification). Files: host/camera/calib_files.py.
 """
 
 from __future__ import annotations
 
+import math
 import os
 import sys
-from dataclasses import dataclass
-from pathlib import Path
+from dataclasses import dataclass, field
 
 import cv2
 import numpy as np
 
 from host.camera.source import CameraError, StereoFrame
-from host.files import write_text_atomic
 
-MIN_PAIRS = 6
+MIN_VIEWS = 15
+# a view is rejected when its RMS reprojection error exceeds both of these
+OUTLIER_FACTOR = 3.0  # times the median view's error
+OUTLIER_FLOOR_PX = 0.3
 MINORU_FOCAL_PX_320 = 426.0  # Minoru sensor at 320x240, without a calibration
 MINORU_BASELINE_M = 0.060
+MATRICES = ("M1", "D1", "M2", "D2", "R", "T", "E", "F", "R1", "R2", "P1", "P2", "Q")
 
 
 @dataclass(frozen=True)
@@ -53,10 +58,10 @@ class Geometry:
 
 @dataclass
 class Calibration:
-    size: tuple[int, int]
-    mats: dict[str, np.ndarray]  # K1 D1 K2 D2 R T E F R1 R2 P1 P2 Q
-    rms: float
-    epipolar_rms: float
+    size: tuple[int, int]  # (width, height) px
+    mats: dict[str, np.ndarray]  # MATRICES
+    rms: float  # px, reprojection RMS of the stereo fit (NaN when not known, e.g. from ROS)
+    epipolar_rms: float  # px, row difference of rectified corners
 
     @property
     def baseline_mm(self) -> float:
@@ -69,34 +74,41 @@ class Calibration:
                         float(p1[0, 2]), float(p1[1, 2]))
 
     def save(self, path: str | os.PathLike[str]) -> None:
-        fs = cv2.FileStorage("calib.yml", cv2.FILE_STORAGE_WRITE | cv2.FILE_STORAGE_MEMORY)
-        fs.write("image_size", np.array(self.size, np.int32))
-        for k, v in self.mats.items():
-            fs.write(k, v)
-        fs.write("rms", self.rms)
-        fs.write("epipolar_rms", self.epipolar_rms)
-        fs.write("baseline_mm", self.baseline_mm)
-        write_text_atomic(path, fs.releaseAndGetString())
+        from host.camera.calib_files import save_opencv
+
+        save_opencv(self, path)
 
     @classmethod
     def load(cls, path: str | os.PathLike[str]) -> Calibration:
-        if not Path(path).is_file():
-            raise CameraError(f"{path}: no such calibration file")
-        try:
-            fs = cv2.FileStorage(str(path), cv2.FILE_STORAGE_READ)
-            ok = fs.isOpened()
-        except cv2.error:
-            ok = False
-        if not ok:
-            raise CameraError(f"{path}: not an OpenCV calibration file")
-        mats = {k: fs.getNode(k).mat() for k in
-                ("K1", "D1", "K2", "D2", "R", "T", "E", "F", "R1", "R2", "P1", "P2", "Q")}
-        missing = [k for k, v in mats.items() if v is None]
-        size = fs.getNode("image_size").mat()
-        if missing or size is None:
-            raise CameraError(f"{path}: missing {', '.join(missing or ['image_size'])}")
-        return cls((int(size.ravel()[0]), int(size.ravel()[1])), mats,
-                   fs.getNode("rms").real(), fs.getNode("epipolar_rms").real())
+        """An OpenCV calibration file, or LEFT.yaml,RIGHT.yaml (ROS camera_info)."""
+        from host.camera.calib_files import load_calibration
+
+        return load_calibration(str(path))
+
+
+@dataclass(frozen=True)
+class View:
+    """One chessboard pair in a calibration: used, rejected (a poor fit) or without board."""
+
+    name: str
+    status: str  # used, rejected, no board
+    error_px: float = math.nan  # RMS reprojection error, worse camera (at rejection time)
+    corners: tuple[np.ndarray, np.ndarray] | None = None  # (left, right), (N, 1, 2) px
+
+
+@dataclass
+class CalibrationRun:
+    """A calibration with the fate of every view."""
+
+    calibration: Calibration
+    views: list[View] = field(default_factory=list)
+
+    def named(self, status: str) -> list[View]:
+        return [v for v in self.views if v.status == status]
+
+    @property
+    def used(self) -> int:
+        return len(self.named("used"))
 
 
 def find_board(image: np.ndarray, board: tuple[int, int]) -> np.ndarray | None:
@@ -117,44 +129,82 @@ def board_points(board: tuple[int, int], square_mm: float) -> np.ndarray:
     return np.hstack([grid * square_mm, np.zeros((len(grid), 1), np.float32)])
 
 
-def calibrate(pairs: list[StereoFrame], board: tuple[int, int], square_mm: float
-              ) -> tuple[Calibration, int]:
-    """Calibrate each camera, then the pair, then rectify; returns (calibration, pairs used)."""
-    if not pairs:
-        raise CameraError("no image pairs to calibrate from")
-    h, w = pairs[0].left.shape[:2]
-    left_pts, right_pts = [], []
-    for frame in pairs:
-        if frame.left.shape[:2] != (h, w) or frame.right.shape[:2] != (h, w):
-            raise CameraError("calibration images differ in size")
-        cl, cr = find_board(frame.left, board), find_board(frame.right, board)
-        if cl is not None and cr is not None:
-            left_pts.append(cl)
-            right_pts.append(cr)
-    if len(left_pts) < MIN_PAIRS:
-        raise CameraError(f"the {board[0]}x{board[1]} chessboard was found in both views of "
-                          f"only {len(left_pts)} of {len(pairs)} pairs; need {MIN_PAIRS} "
-                          f"(check --board: inner corners, columns x rows)")
-    obj = [board_points(board, square_mm)] * len(left_pts)
+def _stereo_fit(obj, left, right, size):
+    """Each camera alone, then the pair: (rms, mats M1 D1 M2 D2 R T E F, per-view RMS (n, 2))."""
     # k3 stays 0: webcam lenses are narrow, and a free k3 fits noise at the image corners
     flags = cv2.CALIB_FIX_K3
-    _, k1, d1, _, _ = cv2.calibrateCamera(obj, left_pts, (w, h), None, None, flags=flags)
-    _, k2, d2, _, _ = cv2.calibrateCamera(obj, right_pts, (w, h), None, None, flags=flags)
+    _, m1, d1, _, _ = cv2.calibrateCamera(obj, left, size, None, None, flags=flags)
+    _, m2, d2, _, _ = cv2.calibrateCamera(obj, right, size, None, None, flags=flags)
     term = (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_MAX_ITER, 100, 1e-6)
-    rms, k1, d1, k2, d2, r, t, e, f = cv2.stereoCalibrate(
-        obj, left_pts, right_pts, k1, d1, k2, d2, (w, h), criteria=term,
+    rms, m1, d1, m2, d2, r, t, e, f, _, _, per_view = cv2.stereoCalibrateExtended(
+        obj, left, right, m1, d1, m2, d2, size, None, None, criteria=term,
         flags=cv2.CALIB_USE_INTRINSIC_GUESS | flags)
-    r1, r2, p1, p2, q, _, _ = cv2.stereoRectify(k1, d1, k2, d2, (w, h), r, t,
-                                                flags=cv2.CALIB_ZERO_DISPARITY, alpha=0)
-    mats = {"K1": k1, "D1": d1, "K2": k2, "D2": d2, "R": r, "T": t, "E": e, "F": f, "R1": r1,
-            "R2": r2, "P1": p1, "P2": p2, "Q": q}
+    mats = {"M1": m1, "D1": d1, "M2": m2, "D2": d2, "R": r, "T": t, "E": e, "F": f}
+    return float(rms), mats, np.asarray(per_view).reshape(-1, 2)
+
+
+def _rectify(mats: dict[str, np.ndarray], size: tuple[int, int]) -> None:
+    r1, r2, p1, p2, q, _, _ = cv2.stereoRectify(
+        mats["M1"], mats["D1"], mats["M2"], mats["D2"], size, mats["R"], mats["T"],
+        flags=cv2.CALIB_ZERO_DISPARITY, alpha=0)
+    mats.update({"R1": r1, "R2": r2, "P1": p1, "P2": p2, "Q": q})
+
+
+def epipolar_rms(mats: dict[str, np.ndarray], left: list, right: list) -> float:
+    """RMS row difference (px) of matching corners after rectification."""
     rows = []
-    for cl, cr in zip(left_pts, right_pts):
-        ul = cv2.undistortPoints(cl, k1, d1, R=r1, P=p1).reshape(-1, 2)
-        ur = cv2.undistortPoints(cr, k2, d2, R=r2, P=p2).reshape(-1, 2)
-        rows.append(ul[:, 1] - ur[:, 1])
-    epi = float(np.sqrt(np.mean(np.concatenate(rows) ** 2)))
-    return Calibration((w, h), mats, float(rms), epi), len(left_pts)
+    for cl, cr in zip(left, right):
+        ul = cv2.undistortPoints(cl, mats["M1"], mats["D1"], R=mats["R1"], P=mats["P1"])
+        ur = cv2.undistortPoints(cr, mats["M2"], mats["D2"], R=mats["R2"], P=mats["P2"])
+        rows.append(ul.reshape(-1, 2)[:, 1] - ur.reshape(-1, 2)[:, 1])
+    return float(np.sqrt(np.mean(np.concatenate(rows) ** 2)))
+
+
+def calibrate(pairs: list[StereoFrame], board: tuple[int, int], square_mm: float,
+              names: list[str] | None = None, min_views: int = MIN_VIEWS) -> CalibrationRun:
+    """Calibrate each camera, then the pair; drop the worst-fitting view while its error is
+    over OUTLIER_FACTOR x the median and OUTLIER_FLOOR_PX, refit; then rectify."""
+    if not pairs:
+        raise CameraError("no image pairs to calibrate from")
+    names = names or [f"pair {i}" for i in range(len(pairs))]
+    h, w = pairs[0].left.shape[:2]
+    views: dict[int, View] = {}
+    found: list[int] = []
+    corners: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+    for i, frame in enumerate(pairs):
+        if frame.left.shape[:2] != (h, w) or frame.right.shape[:2] != (h, w):
+            raise CameraError(f"{names[i]}: calibration images differ in size")
+        cl, cr = find_board(frame.left, board), find_board(frame.right, board)
+        if cl is None or cr is None:
+            views[i] = View(names[i], "no board")
+        else:
+            found.append(i)
+            corners[i] = (cl, cr)
+    need = f"need {min_views} (check --board: inner corners, columns x rows)"
+    if len(found) < min_views:
+        raise CameraError(f"the {board[0]}x{board[1]} chessboard was found in both views of "
+                          f"only {len(found)} of {len(pairs)} pairs; {need}")
+    obj = board_points(board, square_mm)
+    active = list(found)
+    while True:
+        rms, mats, per_view = _stereo_fit([obj] * len(active), [corners[i][0] for i in active],
+                                          [corners[i][1] for i in active], (w, h))
+        err = per_view.max(axis=1)
+        worst = int(np.argmax(err))
+        if err[worst] <= max(OUTLIER_FACTOR * float(np.median(err)), OUTLIER_FLOOR_PX):
+            break
+        views[active[worst]] = View(names[active[worst]], "rejected", float(err[worst]),
+                                    corners[active[worst]])
+        del active[worst]
+        if len(active) < min_views:
+            raise CameraError(f"only {len(active)} of {len(found)} chessboard pairs fit well "
+                              f"({len(found) - len(active)} rejected); {need}")
+    for i, e in zip(active, err):
+        views[i] = View(names[i], "used", float(e), corners[i])
+    _rectify(mats, (w, h))
+    epi = epipolar_rms(mats, [corners[i][0] for i in active], [corners[i][1] for i in active])
+    calib = Calibration((w, h), mats, rms, epi)
+    return CalibrationRun(calib, [views[i] for i in range(len(pairs))])
 
 
 class Rectifier:
@@ -165,7 +215,7 @@ class Rectifier:
         m = calib.mats
         self._maps = [cv2.initUndistortRectifyMap(m[k], m[d], m[r], m[p], calib.size,
                                                   cv2.CV_16SC2)
-                      for k, d, r, p in (("K1", "D1", "R1", "P1"), ("K2", "D2", "R2", "P2"))]
+                      for k, d, r, p in (("M1", "D1", "R1", "P1"), ("M2", "D2", "R2", "P2"))]
 
     def __call__(self, frame: StereoFrame) -> StereoFrame:
         h, w = frame.left.shape[:2]

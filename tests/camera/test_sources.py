@@ -12,9 +12,6 @@ from host.camera import discovery
 from host.camera.minoru import MinoruSource
 from host.camera.replay import ReplaySource
 from host.camera.source import CameraError
-from host.cli import main
-
-from .boards import BOARD, SQUARE_MM, views
 
 
 def _video(path: Path, fps: float, n: int, size=(320, 240)) -> None:
@@ -112,23 +109,3 @@ def test_replay_two_videos(tmp_path: Path) -> None:
     _video(tmp_path / "left.avi", 30, 5)
     _video(tmp_path / "right.avi", 30, 5)
     assert len(list(ReplaySource(tmp_path))) == 5
-
-
-def test_capture_then_calibrate_from_the_command_line(tmp_path: Path, capsys) -> None:
-    shots = tmp_path / "shots"
-    shots.mkdir()
-    for i, f in enumerate(views(10)):
-        cv2.imwrite(str(shots / f"left_{i:03d}.png"), f.left)
-        cv2.imwrite(str(shots / f"right_{i:03d}.png"), f.right)
-    saved = tmp_path / "saved"
-    assert main(["capture", "--camera", f"replay:{shots}", "--count", "8", "--interval", "0",
-                 "--out", str(saved)]) == 0
-    assert len(list(saved.glob("left_*.png"))) == 8
-    calib = tmp_path / "calib.yml"
-    assert main(["calibrate", str(shots), "--board", f"{BOARD[0]}x{BOARD[1]}", "--square",
-                 str(SQUARE_MM), "--out", str(calib)]) == 0
-    out = capsys.readouterr().out
-    assert "reprojection RMS" in out and "baseline 60." in out and calib.exists()
-    assert main(["calibrate", str(shots), "--board", "7x5", "--out",
-                 str(tmp_path / "bad.yml")]) == 2
-    assert not (tmp_path / "bad.yml").exists()
