@@ -7,6 +7,7 @@ from pathlib import Path
 
 import cv2
 
+from host.camera.manifest import read_manifest
 from host.camera.source import CameraError, StereoFrame, StereoSource
 from host.stereo.scenes import read_image
 
@@ -31,12 +32,14 @@ def image_pairs(folder: Path) -> list[tuple[Path, Path]]:
 
 
 class ReplaySource(StereoSource):
-    """Pairs from a folder (at fps, for timestamps) or from two videos (their own timestamps)."""
+    """Pairs from a folder (with the capture times of its manifest.json, else at fps) or from
+    two videos (their own timestamps)."""
 
     def __init__(self, path: Path, fps: float = 30.0) -> None:
-        self.fps = fps
+        self.path, self.fps = path, fps
         self._index = 0
         self._videos = None
+        self.manifest = None
         if path.is_dir() and (path / "left.avi").exists() or str(path).count(",") == 1:
             files = ([path / "left.avi", path / "right.avi"] if path.is_dir()
                      else [Path(p) for p in str(path).split(",")])
@@ -46,6 +49,7 @@ class ReplaySource(StereoSource):
                     raise CameraError(f"{f}: cannot open the video")
         else:
             self._pairs = image_pairs(path)
+            self.manifest = read_manifest(path)
 
     def _read(self) -> StereoFrame | None:
         if self._videos is not None:
@@ -60,8 +64,13 @@ class ReplaySource(StereoSource):
             return None
         left, right = self._pairs[self._index]
         t = self._index / self.fps
+        t_left, t_right = self.manifest["times"].get(left.name, (t, t)) if self.manifest else (t, t)
         self._index += 1
-        return StereoFrame(read_image(left), read_image(right), t, t)
+        return StereoFrame(read_image(left), read_image(right), t_left, t_right)
+
+    def describe(self) -> dict:
+        recorded = self.manifest["camera"] if self.manifest else None
+        return {"camera": f"replay:{self.path}", "kind": "replay", "recorded_from": recorded}
 
     def close(self) -> None:
         for v in self._videos or []:

@@ -63,6 +63,10 @@ class StereoSource:
         self._skews_ms.append(frame.skew_ms)
         return self.rectify(frame) if self.rectify else frame
 
+    def describe(self) -> dict:
+        """What this source is, for a capture's manifest."""
+        return {"kind": type(self).__name__}
+
     def skew_summary(self) -> str:
         """Left/right capture-time skew over the pairs read so far (ms)."""
         s = sorted(self._skews_ms or [])

@@ -1,4 +1,4 @@
-"""host capture: save stereo pairs (for calibration, or to replay later)."""
+"""host capture: save stereo pairs (for calibration, or to replay later) with a manifest."""
 
 from __future__ import annotations
 
@@ -7,6 +7,7 @@ import sys
 import time
 from pathlib import Path
 
+from host.camera.manifest import write_manifest
 from host.camera.open import add_camera_options, open_source
 from host.errors import HostError
 from host.files import write_image_atomic
@@ -17,7 +18,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--count", type=int, default=20, help="pairs to save")
     p.add_argument("--interval", type=float, default=2.0, metavar="S",
                    help="seconds between saved pairs (time to move the chessboard)")
-    p.add_argument("--out", type=Path, required=True, help="folder for left_NNN/right_NNN.png")
+    p.add_argument("--out", type=Path, required=True,
+                   help="folder for left_NNN/right_NNN.png and manifest.json")
     add_camera_options(p)
     p.set_defaults(run=run)
 
@@ -25,18 +27,25 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     if args.count < 1 or args.interval < 0:
         raise HostError("--count must be at least 1 and --interval not negative")
-    args.out.mkdir(parents=True, exist_ok=True)
+    if args.out.exists() and (not args.out.is_dir() or any(args.out.glob("left_*"))):
+        raise HostError(f"{args.out} already holds pairs (or is a file): choose another --out")
     with open_source(args) as source:
-        saved, next_t = 0, time.monotonic()
+        camera = {**source.describe(), "calib": args.calib}
+        pairs: list[dict] = []
+        next_t = time.monotonic()
         for frame in source:
             if time.monotonic() < next_t:
                 continue
+            args.out.mkdir(parents=True, exist_ok=True)  # only once the camera delivers
+            names = {side: f"{side}_{len(pairs):03d}.png" for side in ("left", "right")}
             for side, img in (("left", frame.left), ("right", frame.right)):
-                write_image_atomic(args.out / f"{side}_{saved:03d}.png", img)
-            saved += 1
-            print(f"saved pair {saved}/{args.count} (skew {frame.skew_ms:.1f} ms)",
+                write_image_atomic(args.out / names[side], img)
+            pairs.append({**names, "t_left": frame.t_left, "t_right": frame.t_right})
+            write_manifest(args.out, camera, pairs)
+            print(f"saved pair {len(pairs)}/{args.count} (skew {frame.skew_ms:.1f} ms)",
                   file=sys.stderr)
-            if saved == args.count:
+            if len(pairs) == args.count:
+                print(source.skew_summary(), file=sys.stderr)
                 return 0
             next_t = time.monotonic() + args.interval
-    raise HostError(f"the camera ended after {saved} of {args.count} pairs")
+    raise HostError(f"the camera ended after {len(pairs)} of {args.count} pairs")

@@ -134,3 +134,4 @@ def test_each_bad_calibration_file_is_one_line_and_exit_2(spoiled_run, tmp_path:
         assert code == 2, name
         assert err.count("\n") == 1 and message in err, (name, err)
         assert err.startswith("host capture: error: "), err
+        assert not out.exists(), name  # nothing made for a run that could not start
