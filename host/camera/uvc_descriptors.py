@@ -41,7 +41,7 @@ def _intervals(desc: bytes, kind: int, at: int) -> tuple[float, ...]:
     """Frame rates from the interval table at byte `at`: kind 0 is continuous, else a count."""
     if kind == 0:  # continuous: min, max, step
         lo, hi, _ = struct.unpack_from("<III", desc, at)
-        return tuple(1e7 / v for v in (lo, hi) if v)
+        return tuple(round(1e7 / v, 3) for v in (lo, hi) if v)
     values = struct.unpack_from(f"<{kind}I", desc, at)
     return tuple(round(1e7 / v, 3) for v in values if v)
 

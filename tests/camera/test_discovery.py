@@ -24,6 +24,24 @@ def test_descriptor_modes_round_trip_formats_sizes_and_rates() -> None:
     assert parse_modes(descriptors(SBS)[:-7]) == modes[:4]  # truncated: the whole ones only
 
 
+def test_frame_based_formats_and_continuous_intervals_are_read() -> None:
+    import struct
+
+    from host.camera.uvc_descriptors import (
+        CS_INTERFACE,
+        VS_FORMAT_FRAME_BASED,
+        VS_FRAME_FRAME_BASED,
+    )
+
+    blob = descriptors({})  # the streaming interface, no formats yet
+    blob += struct.pack("<BBBBB16s7B", 28, CS_INTERFACE, VS_FORMAT_FRAME_BASED, 1, 1,
+                        b"H264" + bytes(12), 0, 1, 0, 0, 0, 0, 1)
+    # 1920x1080, continuous from 1/30 s to 1/5 s; bytes per line 0 (compressed)
+    blob += struct.pack("<BBBBBHHIIIBI3I", 38, CS_INTERFACE, VS_FRAME_FRAME_BASED, 1, 0, 1920,
+                        1080, 0, 0, 333333, 0, 0, 333333, 2000000, 333333)
+    assert parse_modes(blob) == [Mode("H264", 1920, 1080, (30.0, 5.0))]
+
+
 def test_one_minoru_left_is_the_lower_hub_port_not_the_lower_node(tmp_path: Path) -> None:
     add_minoru(tmp_path, "1-1.4", first_node=0)  # the port-2 sensor enumerated first
     (cam,) = discover(tmp_path)
