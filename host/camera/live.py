@@ -24,17 +24,32 @@ def open_v4l2(device: str) -> Any:
     return cap
 
 
+def open_all(devices: tuple[str, ...], open_capture: OpenCapture | None) -> list[Any]:
+    """Open every device, or none: the ones already open are released if one fails."""
+    caps: list[Any] = []
+    try:
+        for d in devices:
+            caps.append((open_capture or open_v4l2)(d))
+    except BaseException:
+        for cap in caps:
+            cap.release()
+        raise
+    return caps
+
+
 class LiveSource(StereoSource):
     """A source that streams from V4L2 captures; subclasses set kind, spec and _read."""
 
     kind = "live"
     spec = ""
     devices: tuple[str, ...] = ()
+    swapped = False
 
     def _start(self, caps: list[Any], asked: Format, lock: bool, settle_frames: int,
                stamps: str) -> None:
         """After request(): check the grant, let auto exposure settle, lock, set stampers."""
         self._caps = caps
+        self._stampers = [Stamper(stamps) for _ in caps]
         self.asked = asked
         self.granted = [check_granted(d, c, asked) for d, c in zip(self.devices, caps)]
         self.locked: dict[str, float] = {}
@@ -43,7 +58,6 @@ class LiveSource(StereoSource):
                 for cap in caps:
                     cap.grab()
             self.locked = lock_controls(caps, list(self.devices))
-        self._stampers = [Stamper(stamps) for _ in caps]
 
     @property
     def stamps(self) -> list[str]:
@@ -55,9 +69,10 @@ class LiveSource(StereoSource):
         return {"camera": self.spec, "kind": self.kind, "devices": list(self.devices),
                 "asked": str(self.asked), "granted": [str(g) for g in self.granted],
                 "locked": self.locked, "timestamps": self.stamps,
-                "swapped": getattr(self, "swapped", False)}
+                "swapped": self.swapped}
 
     def swap_views(self) -> None:
+        """Exchange left and right from the next pair on (each camera kind does it its way)."""
         raise NotImplementedError
 
     def close(self) -> None:

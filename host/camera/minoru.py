@@ -9,9 +9,10 @@ capture times differ by more than max_skew_ms is dropped (the older frame is gra
 
 from __future__ import annotations
 
+from host.camera import live
 from host.camera.controls import Format, request
 from host.camera.discovery import resolve
-from host.camera.live import LiveSource, OpenCapture, open_v4l2
+from host.camera.live import LiveSource, OpenCapture
 from host.camera.source import CameraError, StereoFrame
 
 MODES = {(320, 240): 30, (640, 480): 15}
@@ -38,11 +39,15 @@ class MinoruSource(LiveSource):
             devices = (devices[1], devices[0])
         self.spec, self.devices, self.swapped = spec, devices, swap
         self.dropped = 0
-        caps = [(open_capture or open_v4l2)(d) for d in devices]
+        caps = self._caps = live.open_all(devices, open_capture)
         asked = Format("YUYV", size[0], size[1], self.fps, 1)
-        for cap in caps:
-            request(cap, asked)
-        self._start(caps, asked, lock, settle_frames, stamps)
+        try:
+            for cap in caps:
+                request(cap, asked)
+            self._start(caps, asked, lock, settle_frames, stamps)
+        except BaseException:
+            self.close()
+            raise
 
     def swap_views(self) -> None:
         self.devices = (self.devices[1], self.devices[0])

@@ -95,15 +95,15 @@ def check_left_right(source: LiveSource, policy: str, frames: int = 3) -> str:
 def open_source(args: argparse.Namespace) -> StereoSource:
     """The source args.camera names (not sim), with rectification when --calib is given."""
     spec = args.camera
+    rectify = Rectifier(Calibration.load(args.calib)) if args.calib else None  # before a camera
     if spec.startswith("replay:"):
         source: StereoSource = ReplaySource(Path(spec[len("replay:"):]))
     elif spec.split(":")[0] in ("minoru", "sbs"):
         source = _live(args)
     else:
         raise HostError(f"unknown camera {spec!r} (minoru, sbs or replay:DIR)")
+    source.rectify = rectify
     try:
-        if args.calib:
-            source.rectify = Rectifier(Calibration.load(args.calib))
         if isinstance(source, LiveSource) and args.swap_check != "off":
             print(f"camera: {check_left_right(source, args.swap_check)}", file=sys.stderr)
     except BaseException:

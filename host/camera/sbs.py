@@ -9,9 +9,10 @@ from typing import Any
 
 import numpy as np
 
+from host.camera import live
 from host.camera.controls import Format, request
 from host.camera.discovery import resolve
-from host.camera.live import LiveSource, OpenCapture, open_v4l2
+from host.camera.live import LiveSource, OpenCapture
 from host.camera.source import CameraError, StereoFrame
 
 
@@ -46,10 +47,14 @@ class SideBySideSource(LiveSource):
             fourcc = mjpeg[0].fourcc
             fps = fps or mjpeg[0].max_fps
         self.spec, self.devices, self.swapped = spec, camera.nodes, swap
-        cap = (open_capture or open_v4l2)(camera.nodes[0])
+        caps = self._caps = live.open_all(camera.nodes, open_capture)
         asked = Format(fourcc, 2 * w, h, fps or 30.0, 1)
-        request(cap, asked)
-        self._start([cap], asked, lock, settle_frames, stamps)
+        try:
+            request(caps[0], asked)
+            self._start(caps, asked, lock, settle_frames, stamps)
+        except BaseException:
+            self.close()
+            raise
 
     def swap_views(self) -> None:
         self.swapped = not self.swapped

@@ -32,7 +32,7 @@ def _live_minoru(tmp_path: Path, monkeypatch) -> None:
         return FakeCapture([views[device]] * 60, sensor_controls(120, 8, 4500),
                            stamp=lambda i: 5000.0 + i * 1000 / 30 + offset[device])
 
-    monkeypatch.setattr("host.camera.minoru.open_v4l2", open_capture)
+    monkeypatch.setattr("host.camera.live.open_v4l2", open_capture)
 
 
 def test_capture_writes_pairs_and_a_manifest_of_camera_mode_and_times(tmp_path, monkeypatch,

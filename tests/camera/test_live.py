@@ -149,7 +149,7 @@ def test_a_swapped_minoru_is_caught_at_start_through_the_command_line_path(
         caps.append(FakeCapture([views[device]] * 40, sensor_controls(100, 10, 4000)))
         return caps[-1]
 
-    monkeypatch.setattr("host.camera.minoru.open_v4l2", open_capture)
+    monkeypatch.setattr("host.camera.live.open_v4l2", open_capture)
     args = argparse.Namespace(camera="minoru", size="320x240", devices=None, swap=False,
                               swap_check="refuse", timestamps="auto", lock=True, calib=None)
     with pytest.raises(CameraError, match="left and right look swapped .*: pass --swap"):
@@ -168,3 +168,16 @@ def test_a_plain_scene_is_not_judged() -> None:
     flat = np.full((240, 320), 120, np.uint8)
     caps = {"L": FakeCapture([flat] * 5), "R": FakeCapture([flat] * 5)}
     assert "left/right not checked" in check_left_right(_minoru(caps, lock=False), "refuse")
+
+
+def test_when_the_second_sensor_does_not_open_the_first_is_released() -> None:
+    first = FakeCapture([LEFT])
+
+    def open_capture(device: str) -> FakeCapture:
+        if device == "R":
+            raise CameraError("cannot open R")
+        return first
+
+    with pytest.raises(CameraError, match="cannot open R"):
+        MinoruSource(devices=("L", "R"), open_capture=open_capture)
+    assert first.released
