@@ -181,3 +181,26 @@ def test_when_the_second_sensor_does_not_open_the_first_is_released() -> None:
     with pytest.raises(CameraError, match="cannot open R"):
         MinoruSource(devices=("L", "R"), open_capture=open_capture)
     assert first.released
+
+
+def test_a_side_by_side_camera_is_rectified_with_a_calibration_like_any_other(
+        spoiled_run, tmp_path: Path, monkeypatch) -> None:
+    from host.camera.calibration import Rectifier
+
+    from .boards import views
+
+    _sbs_tree(tmp_path, monkeypatch)
+    calib = tmp_path / "calib.yml"
+    spoiled_run.calibration.save(calib)
+    pair = views(1, seed=7)[0]  # 640x480 views: the camera's 1280x480 mode
+    monkeypatch.setattr("host.camera.live.open_v4l2",
+                        lambda d: FakeCapture([np.hstack([pair.left, pair.right])] * 30))
+    args = argparse.Namespace(camera="sbs:/dev/video3", size="640x480", devices=None,
+                              swap=False, swap_check="refuse", timestamps="auto", lock=False,
+                              calib=str(calib))
+    with open_source(args) as src:
+        assert str(src.asked) == "MJPG 1280x480 at 60 fps, 1 buffer"
+        got = src.read()
+    want = Rectifier(spoiled_run.calibration)(pair)
+    np.testing.assert_array_equal(got.left, want.left)
+    np.testing.assert_array_equal(got.right, want.right)
