@@ -174,7 +174,8 @@ def calibrate(pairs: list[StereoFrame], board: tuple[int, int], square_mm: float
     for i, frame in enumerate(pairs):
         if frame.left.shape[:2] != (h, w) or frame.right.shape[:2] != (h, w):
             raise CameraError(f"{names[i]}: calibration images differ in size")
-        cl, cr = find_board(frame.left, board), find_board(frame.right, board)
+        cl = find_board(frame.left, board)
+        cr = None if cl is None else find_board(frame.right, board)
         if cl is None or cr is None:
             views[i] = View(names[i], "no board")
         else:
