@@ -8,6 +8,7 @@ from pathlib import Path
 from host.camera.calibration import calibrate
 from host.camera.replay import ReplaySource
 from host.errors import HostError
+from host.files import check_output
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -26,6 +27,7 @@ def run(args: argparse.Namespace) -> int:
         raise HostError(f"--board must look like 9x6, got {args.board!r}") from None
     if cols < 2 or rows < 2 or args.square <= 0:
         raise HostError("--board needs at least 2x2 inner corners and --square a positive size")
+    check_output(args.out, "yml", "--out")
     pairs = list(ReplaySource(args.folder))
     calib, used = calibrate(pairs, (cols, rows), args.square)
     calib.save(args.out)

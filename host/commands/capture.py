@@ -9,7 +9,7 @@ from pathlib import Path
 
 from host.camera.open import add_camera_options, open_source
 from host.errors import HostError
-from host.files import write_image_atomic
+from host.files import check_folder, write_image_atomic
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -25,7 +25,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     if args.count < 1 or args.interval < 0:
         raise HostError("--count must be at least 1 and --interval not negative")
-    args.out.mkdir(parents=True, exist_ok=True)
+    check_folder(args.out, "--out", create=True)
     with open_source(args) as source:
         saved, next_t = 0, time.monotonic()
         for frame in source:

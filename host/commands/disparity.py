@@ -10,7 +10,7 @@ from pathlib import Path
 import cv2
 
 from host.commands.options import add_matcher_options, params_from_args
-from host.files import write_image_atomic, write_npy_atomic
+from host.files import IMAGE, all_or_nothing, check_output, write_image_atomic, write_npy_atomic
 from host.stereo.matcher import compute_disparity
 from host.stereo.picture import colourise
 from host.stereo.scenes import read_image
@@ -27,6 +27,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_output(args.out, IMAGE, "--out")
+    if args.npy:
+        check_output(args.npy, "npy", "--npy")
     params = params_from_args(args)
     left = read_image(args.left, cv2.IMREAD_UNCHANGED)
     right = read_image(args.right, cv2.IMREAD_UNCHANGED)
@@ -34,9 +37,10 @@ def run(args: argparse.Namespace) -> int:
     disp = compute_disparity(left, right, params)
     ms = (time.perf_counter() - t0) * 1000
     top = params.min_disparity + params.num_disparities
-    write_image_atomic(args.out, colourise(disp, top))
-    if args.npy:
-        write_npy_atomic(args.npy, disp)
+    with all_or_nothing():
+        write_image_atomic(args.out, colourise(disp, top))
+        if args.npy:
+            write_npy_atomic(args.npy, disp)
     density = 100.0 * float((disp == disp).mean())
     print(f"{args.out}: {disp.shape[1]}x{disp.shape[0]}, density {density:.1f}%, "
           f"{ms:.1f} ms ({params.matcher}, window {params.block_size})", file=sys.stderr)

@@ -14,6 +14,7 @@ from host.camera.calibration import Calibration, Geometry
 from host.camera.open import add_camera_options, open_source, parse_size
 from host.commands.options import add_matcher_options, params_from_args
 from host.errors import HostError
+from host.files import check_output
 from host.link.client import RobotLink
 from host.servo.controller import ControlConfig
 from host.servo.loop import Servo
@@ -74,6 +75,10 @@ class _Status:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.log:
+        check_output(args.log, "csv", "--log")
+    if args.plot:
+        check_output(args.plot, "png", "--plot")
     if args.sim:
         args.camera, args.port = "sim", args.port or "emulator"
     if not args.port:

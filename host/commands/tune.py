@@ -10,6 +10,7 @@ from pathlib import Path
 
 from host.commands.options import add_matcher_options, num_disp_given, params_from_args
 from host.errors import HostError
+from host.files import all_or_nothing, check_output
 from host.params_file import save_params
 from host.stereo.scenes import load_scenes
 from host.tuning.learners import METHODS, tune
@@ -55,6 +56,10 @@ def _progress(total: int, enabled: bool):
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.out:
+        check_output(args.out, "toml", "--out")
+    if args.plot:
+        check_output(args.plot, "png", "--plot")
     iterations = DEFAULT_ITERATIONS[args.method] if args.iterations is None else args.iterations
     if args.method != "grid" and iterations < 1:
         raise HostError(f"--iterations must be at least 1, got {iterations}")
@@ -104,16 +109,17 @@ def run(args: argparse.Namespace) -> int:
             bar.close()
     best = space.params(result.best_state)
     held = {s.name: mean_bad([s], best) for s in held_out}
-    if args.out:
-        save_params(args.out, best, {
-            "method": args.method, "space": args.space, "seed": args.seed,
-            "scenes": [s.name for s in tuned_on], "bad": round(result.best_bad, 4),
-            "evaluations": result.evaluations,
-            "date": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")})
-    if args.plot:
-        from host.tuning.plot import plot
+    with all_or_nothing():  # both outputs, or neither
+        if args.out:
+            save_params(args.out, best, {
+                "method": args.method, "space": args.space, "seed": args.seed,
+                "scenes": [s.name for s in tuned_on], "bad": round(result.best_bad, 4),
+                "evaluations": result.evaluations,
+                "date": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")})
+        if args.plot:
+            from host.tuning.plot import plot
 
-        plot(result, args.plot)
+            plot(result, args.plot)
     out = result.to_json() | {"scenes": [s.name for s in tuned_on], "held_out": held}
     if args.json:
         print(json.dumps(out, default=str))
