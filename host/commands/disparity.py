@@ -10,6 +10,7 @@ from pathlib import Path
 import cv2
 
 from host.commands.options import add_matcher_options, params_from_args
+from host.errors import HostError
 from host.files import IMAGE, all_or_nothing, check_output, write_image_atomic, write_npy_atomic
 from host.stereo.matcher import compute_disparity
 from host.stereo.picture import colourise
@@ -33,6 +34,10 @@ def run(args: argparse.Namespace) -> int:
     params = params_from_args(args)
     left = read_image(args.left, cv2.IMREAD_UNCHANGED)
     right = read_image(args.right, cv2.IMREAD_UNCHANGED)
+    if left.ndim != right.ndim and params.colour:  # colour matching needs two colour views
+        kinds = {2: "grey", 3: "colour"}
+        raise HostError(f"{args.left} is {kinds[left.ndim]} and {args.right} "
+                        f"{kinds[right.ndim]}: give a pair of one kind, or --grey")
     t0 = time.perf_counter()
     disp = compute_disparity(left, right, params)
     ms = (time.perf_counter() - t0) * 1000

@@ -41,6 +41,8 @@ class Scene:
 
 
 def read_image(path: Path, flags: int = cv2.IMREAD_COLOR) -> np.ndarray:
+    if path.is_dir():
+        raise HostError(f"{path}: is a folder, not an image")
     if not path.is_file():
         raise HostError(f"{path}: no such file")
     img = cv2.imread(str(path), flags)
