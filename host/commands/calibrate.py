@@ -7,6 +7,7 @@ from pathlib import Path
 
 from host.camera.calibration import calibrate
 from host.camera.replay import ReplaySource
+from host.commands.options import POSITIVE
 from host.errors import HostError
 from host.files import check_output
 
@@ -15,7 +16,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("calibrate", help="calibrate and rectify the stereo camera")
     p.add_argument("folder", type=Path, help="left_*/right_* chessboard pairs")
     p.add_argument("--board", default="9x6", help="inner corners, columns x rows")
-    p.add_argument("--square", type=float, default=25.0, help="square size (mm)")
+    p.add_argument("--square", type=POSITIVE, default=25.0, help="square size (mm)")
     p.add_argument("--out", type=Path, default=Path("calib.yml"), help="calibration file")
     p.set_defaults(run=run)
 
@@ -25,8 +26,8 @@ def run(args: argparse.Namespace) -> int:
         cols, rows = (int(v) for v in args.board.lower().split("x"))
     except ValueError:
         raise HostError(f"--board must look like 9x6, got {args.board!r}") from None
-    if cols < 2 or rows < 2 or args.square <= 0:
-        raise HostError("--board needs at least 2x2 inner corners and --square a positive size")
+    if cols < 2 or rows < 2:
+        raise HostError(f"--board needs at least 2x2 inner corners, got {args.board!r}")
     check_output(args.out, "yml", "--out")
     pairs = list(ReplaySource(args.folder))
     calib, used = calibrate(pairs, (cols, rows), args.square)

@@ -8,14 +8,15 @@ import time
 from pathlib import Path
 
 from host.camera.open import add_camera_options, open_source
+from host.commands.options import COUNT, NON_NEGATIVE
 from host.errors import HostError
 from host.files import check_folder, write_image_atomic
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("capture", help="save stereo image pairs from the camera")
-    p.add_argument("--count", type=int, default=20, help="pairs to save")
-    p.add_argument("--interval", type=float, default=2.0, metavar="S",
+    p.add_argument("--count", type=COUNT, default=20, help="pairs to save")
+    p.add_argument("--interval", type=NON_NEGATIVE, default=2.0, metavar="S",
                    help="seconds between saved pairs (time to move the chessboard)")
     p.add_argument("--out", type=Path, required=True, help="folder for left_NNN/right_NNN.png")
     add_camera_options(p)
@@ -23,8 +24,6 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.count < 1 or args.interval < 0:
-        raise HostError("--count must be at least 1 and --interval not negative")
     check_folder(args.out, "--out", create=True)
     with open_source(args) as source:
         saved, next_t = 0, time.monotonic()

@@ -9,7 +9,12 @@ import time
 from pathlib import Path
 from typing import Any
 
-from host.commands.options import add_matcher_options, num_disp_given, params_from_args
+from host.commands.options import (
+    POSITIVE,
+    add_matcher_options,
+    num_disp_given,
+    params_from_args,
+)
 from host.errors import HostError
 from host.files import (
     IMAGE,
@@ -32,8 +37,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("scenes", nargs="*", type=Path, metavar="SCENE_DIR",
                    help="scene folders, or folders of them (default: the embedded Motorcycle "
                         "pair)")
-    p.add_argument("--scale", type=float, help="ground-truth scale for 2001/2003 layouts")
-    p.add_argument("--rho", type=float, default=1.0, help="bad-pixel threshold (px)")
+    p.add_argument("--scale", type=POSITIVE, help="ground-truth scale for 2001/2003 layouts")
+    p.add_argument("--rho", type=POSITIVE, default=1.0, help="bad-pixel threshold (px)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--picture", type=Path, metavar="DIR",
                    help="write each scene's disparity picture into DIR")

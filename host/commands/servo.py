@@ -12,7 +12,14 @@ from pathlib import Path
 
 from host.camera.calibration import Calibration, Geometry
 from host.camera.open import add_camera_options, open_source, parse_size
-from host.commands.options import add_matcher_options, params_from_args
+from host.commands.options import (
+    NON_NEGATIVE,
+    POSITIVE,
+    add_matcher_options,
+    float_range,
+    int_range,
+    params_from_args,
+)
 from host.errors import HostError
 from host.files import check_output
 from host.link.client import RobotLink
@@ -28,22 +35,25 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--port", help="serial port of the robot, or 'emulator'")
     p.add_argument("--log", type=Path, metavar="run.csv", help="write the run's log")
     p.add_argument("--plot", type=Path, metavar="run.png", help="plot trajectory and commands")
-    p.add_argument("--duration", type=float, metavar="S", help="stop after S seconds")
-    p.add_argument("--settle", type=float, default=1.0, metavar="S",
+    p.add_argument("--duration", type=POSITIVE, metavar="S", help="stop after S seconds")
+    p.add_argument("--settle", type=NON_NEGATIVE, default=1.0, metavar="S",
                    help="end after holding at the target this long (0: run on)")
-    p.add_argument("--tolerance-cm", type=float, default=1.0,
+    p.add_argument("--tolerance-cm", type=POSITIVE, default=1.0,
                    help="stop within this depth of the target (converted to px there)")
     p.add_argument("--mode", choices=("turn", "reverse"), default="turn",
                    help="to come back: turn round and drive (the paper) or reverse")
-    p.add_argument("--turn-s", type=float, help="seconds a turn round takes (default: the "
+    p.add_argument("--turn-s", type=POSITIVE, help="seconds a turn round takes (default: the "
                                                 "simulated robot's, 2 s on a real one)")
-    p.add_argument("--max-duty", type=int, default=600)
-    p.add_argument("--min-duty", type=int, default=180, help="least duty that moves the robot")
+    p.add_argument("--max-duty", type=int_range(1, 1000), default=600,
+                   help="largest duty while driving (permille)")
+    p.add_argument("--min-duty", type=int_range(0, 1000), default=180,
+                   help="least duty that moves the robot (permille)")
     p.add_argument("--marker", choices=("disc", "aruco"), default="disc")
-    p.add_argument("--marker-radius-cm", type=float, default=3.0,
+    p.add_argument("--marker-radius-cm", type=NON_NEGATIVE, default=3.0,
                    help="radius of the marker's dark disc (0: do not check sizes)")
-    p.add_argument("--start-depth", type=float, default=1.9, help="sim: robot's start (m)")
-    p.add_argument("--fps", type=float, default=30.0, help="sim: frame rate")
+    p.add_argument("--start-depth", type=float_range(0.3, 3.0), default=1.9,
+                   help="sim: robot's start (m)")
+    p.add_argument("--fps", type=float_range(1, 1000), default=30.0, help="sim: frame rate")
     add_camera_options(p, sim=True)
     add_matcher_options(p)
     p.set_defaults(run=run)
@@ -79,6 +89,8 @@ def run(args: argparse.Namespace) -> int:
         check_output(args.log, "csv", "--log")
     if args.plot:
         check_output(args.plot, "png", "--plot")
+    if args.min_duty > args.max_duty:
+        raise HostError(f"--min-duty {args.min_duty} exceeds --max-duty {args.max_duty}")
     if args.sim:
         args.camera, args.port = "sim", args.port or "emulator"
     if not args.port:
