@@ -124,7 +124,7 @@ class RobotLink:
             return reply
         good, bad = dec.good_frames - good0, dec.crc_errors + dec.framing_errors - bad0
         noise = self.received_bytes - bytes0
-        raise LinkError(f"no answer to HELLO from a robot on {self.port} within "
+        raise LinkError(f"no answer from a robot on {self.port} within "
                         f"{self.handshake_s:g} s: "
                         f"{_seen(noise, good, bad, good - read[0], self.baud)}")
 
