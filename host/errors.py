@@ -9,6 +9,14 @@ import signal
 class HostError(Exception):
     """A problem with the user's input or environment, stated in one line."""
 
+    status = 2  # the exit status
+
+
+class NotReached(HostError):
+    """The command ran but did not reach its goal (the servo never held at the target)."""
+
+    status = 3
+
 
 class Interrupted(KeyboardInterrupt):
     """A signal that ends a command like Ctrl-C does (SIGTERM, SIGHUP); exit status 128+n."""
@@ -39,8 +47,10 @@ def describe(e: BaseException) -> tuple[int, str] | None:
             signum = getattr(link, "signum", signal.SIGINT)
             name = signal.Signals(signum).name
             return 128 + signum, "interrupted" + ("" if signum == signal.SIGINT else f" ({name})")
+    if isinstance(e, NotReached):
+        return e.status, f"not reached: {e}"
     if isinstance(e, HostError):
-        return 2, f"error: {e}"
+        return e.status, f"error: {e}"
     if isinstance(e, OSError):
         where = f"{e.filename}: " if e.filename else ""
         return 2, f"error: {where}{(e.strerror or _first_line(e)).lower()}"

@@ -12,6 +12,7 @@ from pathlib import Path
 
 from host.camera.calibration import Calibration, Geometry
 from host.camera.open import add_camera_options, open_source, parse_size
+from host.camera.source import CameraError
 from host.commands.options import (
     NON_NEGATIVE,
     POSITIVE,
@@ -20,7 +21,8 @@ from host.commands.options import (
     int_range,
     params_from_args,
 )
-from host.errors import HostError
+from host.commands.servo_outcome import outcome
+from host.errors import HostError, NotReached
 from host.files import check_output
 from host.link.client import RobotLink
 from host.servo.controller import ControlConfig
@@ -146,14 +148,19 @@ def _servo(args, params, source, link, geometry, world, clock) -> int:
     t0 = clock()
     try:
         while True:
-            row = servo.step(world.robot.z_m if world else math.nan)
+            try:
+                row = servo.step(world.robot.z_m if world else math.nan)
+            except CameraError:
+                if not args.camera.startswith("replay:"):
+                    raise
+                break  # the end of a replay ends the run; outcome() tells how it went
             status.show(row)
             if args.duration is not None and clock() - t0 >= args.duration:
                 break
             if args.settle and servo.held_for(args.settle):
                 break
             if world is not None and args.duration is None and clock() - t0 > 60:
-                raise HostError("the simulated robot did not settle within 60 s")
+                raise NotReached("the simulated robot did not settle within 60 s")
     finally:
         status.done()
         if servo.rows:
@@ -161,12 +168,11 @@ def _servo(args, params, source, link, geometry, world, clock) -> int:
                 write_csv(args.log, servo.rows)
             if args.plot:
                 plot_run(args.plot, servo.rows, geometry)
-    last = servo.rows[-1]
-    robot_z = geometry.depth_m(last.robot_px) if last.robot_px > 0 else math.nan
-    msg = (f"held at disparity {last.robot_px:.2f} px ({robot_z:.3f} m) against the target's "
-           f"{target.disparity:.2f} px after {last.t - t0:.1f} s")
+    failed, msg = outcome(servo.rows, geometry.depth_m)
     if world is not None:
         msg += (f"; true robot depth {world.robot.z_m:.3f} m, nearest box "
                 f"{world.nearest_box().z_m:.3f} m")
+    if failed:
+        raise NotReached(msg)
     print(msg, file=sys.stderr)
     return 0
