@@ -13,8 +13,46 @@ from host.signals import signals_interrupt
 COMMANDS = [eval_cmd, disparity, tune, capture, calibrate, servo, emulate]
 
 
+EXAMPLES = {
+    "eval": ["host eval                               # the embedded Motorcycle pair",
+             "host eval ../shared/data/middlebury --matcher ncc --window 7 --picture out/"],
+    "disparity": ["host disparity left.png right.png -o disp.png --num-disp 64 --npy disp.npy"],
+    "tune": ["host tune --out tuned.toml --plot tuning.png",
+             "host tune ../shared/data/middlebury --space sad --method qlearning --workers 2"],
+    "capture": ["host capture --count 20 --interval 2 --out shots/"],
+    "calibrate": ["host calibrate shots/ --board 9x6 --square 25 --out calib.yml"],
+    "servo": ["host servo --sim --log run.csv --plot run.png",
+              "host servo --port /dev/ttyACM0 --calib calib.yml --params tuned.toml"],
+    "emulate": ["host emulate --drop 0.01     # then: host servo --port /dev/pts/N ...",
+                "host emulate --simavr --duration 60"],
+}
+EPILOGS = {
+    "servo": "exit status: 0 held at the target (or stopped by --duration); 2 bad input or a "
+             "link failure;\n3 not reached: the marker was never seen, or the run ended in a "
+             "safe stop;\n128+n ended by signal n (Ctrl-C, SIGTERM, SIGHUP): STOP is sent and "
+             "the log and plot are kept.",
+}
+
+
+class _Formatter(argparse.RawDescriptionHelpFormatter):
+    """Help with each option's default (when it has one worth showing) and the epilog as
+    written (the examples)."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        default = action.default
+        if ("%(default)" in text or "default" in text or default in (None, False, [])
+                or default is argparse.SUPPRESS or not action.option_strings):
+            return text
+        return text + " (default: %(default)s)"
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse with a one-line error (no usage block) and exit status 2."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        kwargs.setdefault("formatter_class", _Formatter)
+        super().__init__(*args, **kwargs)
 
     def error(self, message: str) -> None:  # type: ignore[override]
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
@@ -29,9 +67,12 @@ def build_parser() -> argparse.ArgumentParser:
                                 parser_class=_Parser)
     for command in COMMANDS:
         command.add_parser(sub)
-    for p in sub.choices.values():  # --debug also after the command's name
+    for name, p in sub.choices.items():
         p.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
                        help="show the traceback of an error instead of one line")
+        examples = "\n".join(f"  {line}" for line in EXAMPLES.get(name, []))
+        p.epilog = "\n\n".join(t for t in (EPILOGS.get(name), examples and
+                                              "examples:\n" + examples) if t)
     return parser
 
 

@@ -13,15 +13,16 @@ from host.commands.options import add_matcher_options, params_from_args
 from host.errors import HostError
 from host.files import IMAGE, all_or_nothing, check_output, write_image_atomic, write_npy_atomic
 from host.stereo.matcher import compute_disparity
-from host.stereo.picture import colourise
+from host.stereo.picture import picture
 from host.stereo.scenes import read_image
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("disparity", help="compute a disparity map from a rectified pair")
-    p.add_argument("left", type=Path)
-    p.add_argument("right", type=Path)
-    p.add_argument("-o", "--out", type=Path, required=True, help="colour-mapped picture (PNG)")
+    p.add_argument("left", type=Path, help="left image of a rectified pair")
+    p.add_argument("right", type=Path, help="right image, same size and kind")
+    p.add_argument("-o", "--out", type=Path, required=True,
+                   help="picture with a colour bar (.png, .jpg ...)")
     p.add_argument("--npy", type=Path, help="also write the raw float32 map (px, NaN = none)")
     add_matcher_options(p)
     p.set_defaults(run=run)
@@ -43,7 +44,7 @@ def run(args: argparse.Namespace) -> int:
     ms = (time.perf_counter() - t0) * 1000
     top = params.min_disparity + params.num_disparities
     with all_or_nothing():
-        write_image_atomic(args.out, colourise(disp, top))
+        write_image_atomic(args.out, picture(disp, top))
         if args.npy:
             write_npy_atomic(args.npy, disp)
     density = 100.0 * float((disp == disp).mean())

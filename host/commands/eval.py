@@ -28,7 +28,7 @@ from host.files import (
 from host.stereo.matcher import compute_disparity, warm_up
 from host.stereo.metrics import evaluate
 from host.stereo.params import MatcherParams
-from host.stereo.picture import colourise
+from host.stereo.picture import picture
 from host.stereo.scenes import Scene, load_scenes
 
 
@@ -95,5 +95,5 @@ def _score(scene: Scene, params: MatcherParams, args: argparse.Namespace) -> dic
     if args.picture:
         path = check_output(inside(args.picture, safe_name(scene.name, ".png")), IMAGE,
                             "--picture")
-        write_image_atomic(path, colourise(row["disp"], p.min_disparity + p.num_disparities))
+        write_image_atomic(path, picture(row["disp"], p.min_disparity + p.num_disparities))
     return row

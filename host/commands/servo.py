@@ -50,7 +50,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="largest duty while driving (permille)")
     p.add_argument("--min-duty", type=int_range(0, 1000), default=180,
                    help="least duty that moves the robot (permille)")
-    p.add_argument("--marker", choices=("disc", "aruco"), default="disc")
+    p.add_argument("--marker", choices=("disc", "aruco"), default="disc",
+                   help="the robot's marker: a dark disc, or an ArUco tag")
     p.add_argument("--marker-radius-cm", type=NON_NEGATIVE, default=3.0,
                    help="radius of the marker's dark disc (0: do not check sizes)")
     p.add_argument("--start-depth", type=float_range(0.3, 3.0), default=1.9,

@@ -33,8 +33,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("tune", help="tune the matcher's parameters against ground truth")
     p.add_argument("scenes", nargs="*", type=Path, metavar="SCENE_DIR",
                    help="scenes with ground truth (default: the embedded Motorcycle pair)")
-    p.add_argument("--space", choices=SPACES, default="window")
-    p.add_argument("--method", choices=METHODS, default="paper")
+    p.add_argument("--space", choices=SPACES, default="window",
+                   help="parameters to tune: the window alone, or a matcher's several")
+    p.add_argument("--method", choices=METHODS, default="paper",
+                   help="the paper's Q-learner, full Q-learning, grid or random search")
     p.add_argument("--iterations", type=int_range(0),
                    help="learner steps (default: paper 20, qlearning 300, random 60; grid: all)")
     p.add_argument("--seed", type=SEED, default=0, help="seed of the learner")
