@@ -107,6 +107,8 @@ def run(args: argparse.Namespace) -> int:
 
             emulator = Emulator(line_rate=args.camera != "sim")
             service = stack.enter_context(PtyService(emulator, realtime=args.camera != "sim"))
+        # the port first: a wrong one fails before a camera is opened
+        link = stack.enter_context(RobotLink(service.path if service else args.port))
         if args.camera == "sim":
             if emulator is None:
                 raise HostError("--camera sim needs --port emulator (the simulated robot)")
@@ -116,7 +118,6 @@ def run(args: argparse.Namespace) -> int:
             world, clock = None, time.monotonic
             geometry = (Calibration.load(args.calib).geometry if args.calib
                         else Geometry.minoru_default(*parse_size(args.size)))
-        link = stack.enter_context(RobotLink(service.path if service else args.port))
         return _servo(args, params, source, link, geometry, world, clock)
 
 
