@@ -99,6 +99,8 @@ def run(args: argparse.Namespace) -> int:
     if not args.port:
         raise HostError("--port is needed (a serial port, or 'emulator'); --sim runs it all "
                         "simulated")
+    if args.camera == "sim" and args.port != "emulator":
+        raise HostError("--camera sim needs --port emulator (the simulated robot)")
     params = params_from_args(args)
     with contextlib.ExitStack() as stack:
         emulator, service = None, None
@@ -110,8 +112,6 @@ def run(args: argparse.Namespace) -> int:
         # the port first: a wrong one fails before a camera is opened
         link = stack.enter_context(RobotLink(service.path if service else args.port))
         if args.camera == "sim":
-            if emulator is None:
-                raise HostError("--camera sim needs --port emulator (the simulated robot)")
             source, world, geometry, clock = _sim(args, emulator)
         else:
             source = stack.enter_context(open_source(args))
