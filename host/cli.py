@@ -13,6 +13,7 @@ from host.signals import signals_interrupt
 COMMANDS = [eval_cmd, disparity, tune, capture, calibrate, servo, emulate]
 
 
+# one or two examples per command (a command module may define EXAMPLES itself instead)
 EXAMPLES = {
     "eval": ["host eval                               # the embedded Motorcycle pair",
              "host eval ../shared/data/middlebury --matcher ncc --window 7 --picture out/"],
@@ -66,14 +67,19 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND",
                                 parser_class=_Parser)
     for command in COMMANDS:
+        before = set(sub.choices)
         command.add_parser(sub)
-    for name, p in sub.choices.items():
-        p.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
-                       help="show the traceback of an error instead of one line")
-        examples = "\n".join(f"  {line}" for line in EXAMPLES.get(name, []))
-        p.epilog = "\n\n".join(t for t in (EPILOGS.get(name), examples and
-                                              "examples:\n" + examples) if t)
+        for name in set(sub.choices) - before:  # a command module may keep its own EXAMPLES
+            _finish(name, sub.choices[name], getattr(command, "EXAMPLES", EXAMPLES.get(name)))
     return parser
+
+
+def _finish(name: str, p: argparse.ArgumentParser, examples: list[str] | None) -> None:
+    """--debug after the command's name too; the epilog: exit statuses and examples."""
+    p.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                   help="show the traceback of an error instead of one line")
+    text = "\n".join(f"  {line}" for line in examples or [])
+    p.epilog = "\n\n".join(t for t in (EPILOGS.get(name), text and "examples:\n" + text) if t)
 
 
 def main(argv: list[str] | None = None) -> int:
