@@ -8,9 +8,13 @@ import threading
 import time
 import tty
 from collections.abc import Iterator
+from pathlib import Path
 
+import cv2
+import numpy as np
 import pytest
 
+from host.cli import main
 from host.emulator.emulator import Emulator, Faults, PtyService
 from host.link.client import LinkError, RobotLink
 from host.link.frame import encode_frame
@@ -83,3 +87,15 @@ def test_a_robot_of_another_schema_hash_is_named() -> None:
         with pytest.raises(LinkError, match="protocol mismatch: .* spec 0x[0-9A-F]{8}, this "
                                             "host from 0x00000001"):
             RobotLink(service.path, expected_hash=1).open()
+
+
+def test_host_servo_on_a_garbling_port_says_so_in_one_line(far_end: FarEnd, tmp_path: Path,
+                                                           capsys) -> None:
+    grey = np.zeros((60, 80), np.uint8)
+    for name in ("left_000.png", "right_000.png"):
+        cv2.imwrite(str(tmp_path / name), grey)
+    far_end.repeat(bytes(range(0, 256, 7)))
+    assert main(["servo", "--camera", f"replay:{tmp_path}", "--port", far_end.port]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("host servo: error: no answer from a robot")
+    assert "only garbled frames arrived" in err
