@@ -74,6 +74,10 @@ def files(tmp_path: Path) -> dict[str, Path]:
     f["notable"].write_text("matcher = 'sad'\n")
     f["nan"].write_text("[matcher]\nlr_check = nan\n")
     f["unknown"].write_text("[matcher]\nwindow_size = 7\n")
+    for name, meta in (("scene_list", [1, 2]), ("scene_zero", {"scale": 0}),
+                       ("scene_nan", {"scale": "nan"}),
+                       ("scene_top", {"scale": 4, "max_disparity": "abc"})):
+        f[name] = _scene(tmp_path / name, meta)
     f["replay"].mkdir()
     cv2.imwrite(str(f["replay"] / "left_000.png"), grey)
     cv2.imwrite(str(f["replay"] / "right_000.png"), grey)
@@ -118,6 +122,11 @@ ROWS = [
     (["disparity", "{tmp}/none.png", "{r}", "-o", "{tmp}/o.png"], "none.png: no such file"),
     (["disparity", "{junk}", "{r}", "-o", "{tmp}/o.png"], "not a readable image"),
     (["disparity", "{l}", "{small}", "-o", "{tmp}/o.png"], "differ in size"),
+    # inputs: scenes whose meta.json is hostile
+    (["eval", "{scene_list}"], "meta.json: unreadable or lacks 'scale'"),
+    (["eval", "{scene_zero}"], "meta.json: needs a positive 'scale'"),
+    (["eval", "{scene_nan}"], "meta.json: needs a positive 'scale'"),
+    (["eval", "{scene_top}"], "meta.json: needs a positive 'scale'"),
     # inputs: params files
     (DISP + ["-o", "{tmp}/o.png", "--params", "{utf16}"], "not UTF-8 text"),
     (DISP + ["-o", "{tmp}/o.png", "--params", "{big}"], "big.toml: bad value"),
@@ -168,15 +177,15 @@ def test_bad_input_is_one_line_exit_2_and_writes_nothing(
     assert not any(p.name.startswith(".") for p in tmp_path.rglob("*"))  # no temporaries
 
 
-def _scene(folder: Path, name: str) -> Path:
-    """A scene in the shared layout whose meta.json names it `name`."""
+def _scene(folder: Path, meta: object) -> Path:
+    """A scene in the shared layout with this meta.json."""
     s = synthetic_scene(seed=3, width=96, height=64, max_disp=12)
     folder.mkdir()
     cv2.imwrite(str(folder / "left.png"), s.left)
     cv2.imwrite(str(folder / "right.png"), s.right)
     gt = np.nan_to_num(s.gt * 4).astype(np.uint8)
     cv2.imwrite(str(folder / "disp_left.png"), gt)
-    (folder / "meta.json").write_text(json.dumps({"scale": 4, "scene": name}))
+    (folder / "meta.json").write_text(json.dumps(meta))
     return folder
 
 
@@ -185,7 +194,7 @@ def _scene(folder: Path, name: str) -> Path:
                                         ("..", "unnamed.png")])
 def test_a_picture_named_from_data_stays_inside_the_folder(
         tmp_path: Path, name: str, file: str, capsys: pytest.CaptureFixture[str]) -> None:
-    scene = _scene(tmp_path / "scene", name)
+    scene = _scene(tmp_path / "scene", {"scale": 4, "scene": name})
     out = tmp_path / "deep" / "out"
     out.mkdir(parents=True)
     before = _tree(tmp_path)
