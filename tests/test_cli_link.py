@@ -99,3 +99,8 @@ def test_host_servo_on_a_garbling_port_says_so_in_one_line(far_end: FarEnd, tmp_
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("host servo: error: no answer from a robot")
     assert "only garbled frames arrived" in err
+
+
+def test_a_line_that_echoes_is_named() -> None:
+    with pytest.raises(LinkError, match="the line echoes"):
+        RobotLink("loop://", handshake_s=0.4).open()

@@ -105,10 +105,11 @@ class RobotLink:
         dec = self._dec
         good0, bad0 = dec.good_frames, dec.crc_errors + dec.framing_errors
         bytes0 = self.received_bytes
-        read = [0]  # frames that decoded to a message of this host's spec
+        read = [0, 0]  # frames that decoded to a message of this host's spec; of them, HELLOs
 
         def is_reply(m: Any) -> bool:
             read[0] += 1
+            read[1] += isinstance(m, gen.Hello)  # our own HELLO: the line echoes
             return isinstance(m, gen.HelloReply) and m.nonce == nonce
 
         while time.monotonic() < deadline:
@@ -126,7 +127,7 @@ class RobotLink:
         noise = self.received_bytes - bytes0
         raise LinkError(f"no answer from a robot on {self.port} within "
                         f"{self.handshake_s:g} s: "
-                        f"{_seen(noise, good, bad, good - read[0], self.baud)}")
+                        f"{_seen(noise, good, bad, good - read[0], read[1], self.baud)}")
 
     def _next_seq(self) -> int:
         self._seq = (self._seq + 1) & 0xFF
@@ -210,11 +211,13 @@ def _reason(e: BaseException) -> str:
     return text.splitlines()[0]
 
 
-def _seen(nbytes: int, good: int, bad: int, unreadable: int, baud: int) -> str:
+def _seen(nbytes: int, good: int, bad: int, unreadable: int, echoed: int, baud: int) -> str:
     """What arrived during a failed handshake, and what that suggests."""
     if unreadable:
         return (f"{unreadable} frame(s) arrived that this host cannot read: a robot built from "
                 f"another protocol spec? flash the firmware built from this checkout")
+    if good and echoed == good:
+        return "only our own HELLO came back: the line echoes (a loopback, not the robot)"
     if good:
         return f"{good} frame(s) arrived but none answered HELLO"
     if nbytes:
