@@ -4,6 +4,7 @@ shown, each command ends with examples; the disparity picture has a colour bar a
 from __future__ import annotations
 
 import argparse
+import shlex
 
 import cv2
 import numpy as np
@@ -28,6 +29,8 @@ def test_every_command_documents_each_option_and_ends_with_examples(name: str) -
     examples = text.split("examples:\n")[-1].splitlines()
     assert "examples:\n" in text and 1 <= len(examples) <= 2
     assert all(line.strip().startswith(f"host {name}") for line in examples)
+    for line in examples:  # each example is a command line the parser accepts
+        build_parser().parse_args(shlex.split(line.split("#")[0])[1:])
 
 
 def test_defaults_are_shown() -> None:
