@@ -116,6 +116,9 @@ ROWS = [
     (DISP + ["-o", "{tmp}"], "is a folder"),
     (["eval", "--picture", "{tmp}/none"], "--picture {tmp}/none: no such folder"),
     (["calibrate", "{replay}", "--out", "{ro}/calib.yml"], "cannot write in folder"),
+    (["capture", "--out", "{ro}"], "--out {ro}: cannot write in folder"),
+    (["capture", "--out", "{ro}/shots"], "--out {ro}/shots: cannot make the folder"),
+    (["capture", "--out", "{l}"], "not a folder"),
     # inputs: images
     (["disparity", "{colour}", "{r}", "-o", "{tmp}/o.png"], "is colour and"),
     (["disparity", "{tmp}", "{r}", "-o", "{tmp}/o.png"], "is a folder, not an image"),
