@@ -7,13 +7,56 @@ import sys
 
 from host.commands import calibrate, cameras, capture, disparity, emulate, servo, tune
 from host.commands import eval as eval_cmd
-from host.errors import HostError
+from host.errors import describe
+from host.signals import signals_interrupt
 
 COMMANDS = [eval_cmd, disparity, tune, cameras, capture, calibrate, servo, emulate]
 
 
+# one or two examples per command (a command module may define EXAMPLES itself instead)
+EXAMPLES = {
+    "eval": ["host eval                               # the embedded Motorcycle pair",
+             "host eval ../shared/data/middlebury --matcher ncc --window 7 --picture out/"],
+    "disparity": ["host disparity left.png right.png -o disp.png --num-disp 64 --npy disp.npy"],
+    "tune": ["host tune --out tuned.toml --plot tuning.png",
+             "host tune ../shared/data/middlebury --space sad --method qlearning --workers 2"],
+    "cameras": ["host cameras                  # the stereo cameras plugged in, with their --camera",
+                "host cameras --sysfs /tmp/fake-sys"],
+    "capture": ["host capture --count 25 --interval 2 --out shots/"],
+    "calibrate": ["host calibrate shots/ --board 9x6 --square 25 --out calib.yml",
+                  "host calibrate shots/ --out calib.yml --ros ros/ --picture check.png"],
+    "servo": ["host servo --sim --log run.csv --plot run.png",
+              "host servo --port /dev/ttyACM0 --calib calib.yml --params tuned.toml"],
+    "emulate": ["host emulate --drop 0.01     # then: host servo --port /dev/pts/N ...",
+                "host emulate --simavr --duration 60"],
+}
+EPILOGS = {
+    "servo": "exit status: 0 held at the target (or stopped by --duration); 2 bad input or a "
+             "link failure;\n3 not reached: the marker was never seen, or the run ended in a "
+             "safe stop;\n128+n ended by signal n (Ctrl-C, SIGTERM, SIGHUP): STOP is sent and "
+             "the log and plot are kept.",
+}
+
+
+class _Formatter(argparse.RawDescriptionHelpFormatter):
+    """Help with each option's default (when it has one worth showing) and the epilog as
+    written (the examples)."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        default = action.default
+        if ("%(default)" in text or "default" in text or default in (None, False, [])
+                or default is argparse.SUPPRESS or not action.option_strings):
+            return text
+        return text + " (default: %(default)s)"
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse with a one-line error (no usage block) and exit status 2."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        kwargs.setdefault("formatter_class", _Formatter)
+        super().__init__(*args, **kwargs)
 
     def error(self, message: str) -> None:  # type: ignore[override]
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
@@ -22,27 +65,43 @@ class _Parser(argparse.ArgumentParser):
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="host", description="stereo-servo host: stereo matching, tuning and the robot servo")
+    parser.add_argument("--debug", action="store_true",
+                        help="show the traceback of an error instead of one line")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND",
                                 parser_class=_Parser)
     for command in COMMANDS:
+        before = set(sub.choices)
         command.add_parser(sub)
+        for name in set(sub.choices) - before:  # a command module may keep its own EXAMPLES
+            _finish(name, sub.choices[name], getattr(command, "EXAMPLES", EXAMPLES.get(name)))
     return parser
 
 
+def _finish(name: str, p: argparse.ArgumentParser, examples: list[str] | None) -> None:
+    """--debug after the command's name too; the epilog: exit statuses and examples."""
+    p.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                   help="show the traceback of an error instead of one line")
+    text = "\n".join(f"  {line}" for line in examples or [])
+    p.epilog = "\n\n".join(t for t in (EPILOGS.get(name), text and "examples:\n" + text) if t)
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Run a subcommand; a HostError becomes one line on stderr and exit status 2."""
+    """Run a subcommand. Bad input (a HostError, an OSError, a library's error on the user's
+    data) becomes one line on stderr and exit status 2; SIGINT, SIGTERM and SIGHUP end it like
+    Ctrl-C with status 128+n; --debug shows the traceback instead."""
     args = build_parser().parse_args(argv)
     try:
-        return int(args.run(args))
-    except HostError as e:
-        print(f"host {args.command}: error: {e}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print(f"host {args.command}: interrupted", file=sys.stderr)
-        return 130
+        with signals_interrupt():
+            return int(args.run(args))
     except BrokenPipeError:  # the reader (head, less) went away: not an error of ours
         sys.stderr.close()
         return 0
+    except BaseException as e:
+        said = None if args.debug or isinstance(e, SystemExit) else describe(e)
+        if said is None:
+            raise
+        print(f"host {args.command}: {said[1]}", file=sys.stderr)
+        return said[0]
 
 
 if __name__ == "__main__":

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 import tomllib
 from pathlib import Path
@@ -42,14 +43,28 @@ def save_params(path: str | os.PathLike[str], params: MatcherParams,
 def load_params(path: str | os.PathLike[str]) -> tuple[MatcherParams, dict[str, Any]]:
     """Read a params file; returns the validated matcher parameters and the [tuning] table."""
     p = Path(path)
+    if p.is_dir():
+        raise HostError(f"{p}: is a folder, not a params file")
     try:
-        data = tomllib.loads(p.read_text())
+        data = tomllib.loads(p.read_bytes().decode("utf-8"))
     except OSError as e:
         raise HostError(f"{p}: cannot read ({e.strerror})") from None
+    except UnicodeDecodeError as e:
+        raise HostError(f"{p}: not a TOML file (not UTF-8 text: byte 0x{e.object[e.start]:02X} "
+                        f"at {e.start})") from None
     except tomllib.TOMLDecodeError as e:
         raise HostError(f"{p}: not a valid TOML file ({e})") from None
+    except ValueError as e:  # a number beyond Python's digit limit, and the like
+        raise HostError(f"{p}: bad value ({str(e).split(';')[0]})") from None
+    except RecursionError:
+        raise HostError(f"{p}: not a params file (nested too deeply)") from None
+    if not isinstance(data.get("matcher", {}), dict):
+        raise HostError(f"{p}: [matcher] must be a table")
     if "matcher" not in data:
         raise HostError(f"{p}: no [matcher] table")
+    for key, value in data["matcher"].items():
+        if isinstance(value, float) and not math.isfinite(value):
+            raise HostError(f"{p}: matcher parameter {key} must be a finite number, got {value}")
     try:
         params = MatcherParams.from_dict(data["matcher"]).validate()
     except HostError as e:

@@ -11,8 +11,9 @@ from host.camera.calib_report import check_picture, coverage, coverage_lines
 from host.camera.calibration import MIN_VIEWS, calibrate
 from host.camera.replay import image_pairs
 from host.camera.source import StereoFrame
+from host.commands.options import COUNT, POSITIVE
 from host.errors import HostError
-from host.files import write_image_atomic
+from host.files import check_output, write_image_atomic
 from host.stereo.scenes import read_image
 
 
@@ -20,13 +21,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("calibrate", help="calibrate and rectify the stereo camera")
     p.add_argument("folder", type=Path, help="left_*/right_* chessboard pairs")
     p.add_argument("--board", default="9x6", help="inner corners, columns x rows")
-    p.add_argument("--square", type=float, default=25.0, help="square size (mm)")
+    p.add_argument("--square", type=POSITIVE, default=25.0, help="square size (mm)")
     p.add_argument("--out", type=Path, default=Path("calib.yml"), help="calibration file")
     p.add_argument("--ros", type=Path, metavar="DIR",
                    help="also write DIR/left.yaml and DIR/right.yaml (ROS camera_info)")
     p.add_argument("--picture", type=Path, metavar="PNG",
                    help="the first used pair rectified, with horizontal lines to check by eye")
-    p.add_argument("--min-views", type=int, default=MIN_VIEWS,
+    p.add_argument("--min-views", type=COUNT, default=MIN_VIEWS,
                    help="least number of well-fitting chessboard pairs")
     p.set_defaults(run=run)
 
@@ -36,12 +37,15 @@ def run(args: argparse.Namespace) -> int:
         cols, rows = (int(v) for v in args.board.lower().split("x"))
     except ValueError:
         raise HostError(f"--board must look like 9x6, got {args.board!r}") from None
-    if cols < 2 or rows < 2 or args.square <= 0:
-        raise HostError("--board needs at least 2x2 inner corners and --square a positive size")
+    if cols < 2 or rows < 2:
+        raise HostError(f"--board needs at least 2x2 inner corners, got {args.board!r}")
     if args.min_views < 3:
         raise HostError("--min-views must be at least 3")
     if args.ros is not None and not args.ros.is_dir():
         raise HostError(f"--ros {args.ros}: no such folder")
+    check_output(args.out, "yml", "--out")
+    if args.picture is not None:
+        check_output(args.picture, "image", "--picture")
     files = image_pairs(args.folder)
     pairs = [StereoFrame(read_image(lf), read_image(rf), 0.0, 0.0) for lf, rf in files]
     result = calibrate(pairs, (cols, rows), args.square, [lf.name[5:] for lf, _ in files],

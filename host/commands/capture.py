@@ -9,14 +9,15 @@ from pathlib import Path
 
 from host.camera.manifest import write_manifest
 from host.camera.open import add_camera_options, open_source
+from host.commands.options import COUNT, NON_NEGATIVE
 from host.errors import HostError
-from host.files import write_image_atomic
+from host.files import check_folder, write_image_atomic
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("capture", help="save stereo image pairs from the camera")
-    p.add_argument("--count", type=int, default=20, help="pairs to save")
-    p.add_argument("--interval", type=float, default=2.0, metavar="S",
+    p.add_argument("--count", type=COUNT, default=20, help="pairs to save")
+    p.add_argument("--interval", type=NON_NEGATIVE, default=2.0, metavar="S",
                    help="seconds between saved pairs (time to move the chessboard)")
     p.add_argument("--out", type=Path, required=True,
                    help="folder for left_NNN/right_NNN.png and manifest.json")
@@ -25,10 +26,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.count < 1 or args.interval < 0:
-        raise HostError("--count must be at least 1 and --interval not negative")
     if args.out.exists() and (not args.out.is_dir() or any(args.out.glob("left_*"))):
         raise HostError(f"{args.out} already holds pairs (or is a file): choose another --out")
+    # writable now, but made only once the camera delivers (nothing left behind on failure)
+    existing = next(p for p in (args.out, *args.out.parents) if p.exists())
+    check_folder(existing, "--out", target=args.out)
     with open_source(args) as source:
         camera = {**source.describe(), "calib": args.calib}
         pairs: list[dict] = []

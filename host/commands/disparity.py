@@ -10,33 +10,43 @@ from pathlib import Path
 import cv2
 
 from host.commands.options import add_matcher_options, params_from_args
-from host.files import write_image_atomic, write_npy_atomic
+from host.errors import HostError
+from host.files import IMAGE, all_or_nothing, check_output, write_image_atomic, write_npy_atomic
 from host.stereo.matcher import compute_disparity
-from host.stereo.picture import colourise
+from host.stereo.picture import picture
 from host.stereo.scenes import read_image
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("disparity", help="compute a disparity map from a rectified pair")
-    p.add_argument("left", type=Path)
-    p.add_argument("right", type=Path)
-    p.add_argument("-o", "--out", type=Path, required=True, help="colour-mapped picture (PNG)")
+    p.add_argument("left", type=Path, help="left image of a rectified pair")
+    p.add_argument("right", type=Path, help="right image, same size and kind")
+    p.add_argument("-o", "--out", type=Path, required=True,
+                   help="picture with a colour bar (.png, .jpg ...)")
     p.add_argument("--npy", type=Path, help="also write the raw float32 map (px, NaN = none)")
     add_matcher_options(p)
     p.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    check_output(args.out, IMAGE, "--out")
+    if args.npy:
+        check_output(args.npy, "npy", "--npy")
     params = params_from_args(args)
     left = read_image(args.left, cv2.IMREAD_UNCHANGED)
     right = read_image(args.right, cv2.IMREAD_UNCHANGED)
+    if left.ndim != right.ndim and params.colour:  # colour matching needs two colour views
+        kinds = {2: "grey", 3: "colour"}
+        raise HostError(f"{args.left} is {kinds[left.ndim]} and {args.right} "
+                        f"{kinds[right.ndim]}: give a pair of one kind, or --grey")
     t0 = time.perf_counter()
     disp = compute_disparity(left, right, params)
     ms = (time.perf_counter() - t0) * 1000
     top = params.min_disparity + params.num_disparities
-    write_image_atomic(args.out, colourise(disp, top))
-    if args.npy:
-        write_npy_atomic(args.npy, disp)
+    with all_or_nothing():
+        write_image_atomic(args.out, picture(disp, top))
+        if args.npy:
+            write_npy_atomic(args.npy, disp)
     density = 100.0 * float((disp == disp).mean())
     print(f"{args.out}: {disp.shape[1]}x{disp.shape[0]}, density {density:.1f}%, "
           f"{ms:.1f} ms ({params.matcher}, window {params.block_size})", file=sys.stderr)

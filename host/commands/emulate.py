@@ -10,6 +10,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from host.commands.options import NON_NEGATIVE, POSITIVE, SEED, float_range
 from host.emulator.emulator import Emulator, Faults, PtyService
 from host.errors import HostError
 
@@ -18,30 +19,26 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("emulate", help="run the robot's firmware on a pseudo-terminal")
     p.add_argument("--simavr", action="store_true",
                    help="run the real AVR binary in simavr instead of the natively built core")
-    p.add_argument("--drop", type=float, default=0.0, metavar="RATE",
+    p.add_argument("--drop", type=RATE, default=0.0, metavar="RATE",
                    help="drop this share of the bytes, both ways")
-    p.add_argument("--corrupt", type=float, default=0.0, metavar="RATE",
+    p.add_argument("--corrupt", type=RATE, default=0.0, metavar="RATE",
                    help="corrupt this share of the bytes, both ways")
-    p.add_argument("--delay-ms", type=float, default=0.0, help="delay every byte (ms)")
-    p.add_argument("--silent-after", type=float, metavar="S",
+    p.add_argument("--delay-ms", type=NON_NEGATIVE, default=0.0, help="delay every byte (ms)")
+    p.add_argument("--silent-after", type=NON_NEGATIVE, metavar="S",
                    help="stop answering (cut the line) after S seconds")
-    p.add_argument("--seed", type=int, default=0, help="seed of the fault injection")
-    p.add_argument("--duration", type=float, metavar="S", help="stop after S seconds")
+    p.add_argument("--seed", type=SEED, default=0, help="seed of the fault injection")
+    p.add_argument("--duration", type=POSITIVE, metavar="S", help="stop after S seconds")
     p.set_defaults(run=run)
+
+
+RATE = float_range(0, 1, hi_open=True)
 
 
 def _interrupt(*_: object) -> None:
     raise KeyboardInterrupt
 
 
-def _check_rate(name: str, value: float) -> None:
-    if not 0.0 <= value < 1.0:
-        raise HostError(f"--{name} must be in [0, 1), got {value}")
-
-
 def run(args: argparse.Namespace) -> int:
-    _check_rate("drop", args.drop)
-    _check_rate("corrupt", args.corrupt)
     signal.signal(signal.SIGTERM, _interrupt)  # kill ends it like Ctrl-C
     if args.simavr:
         return _run_simavr(args)

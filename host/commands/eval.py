@@ -9,13 +9,26 @@ import time
 from pathlib import Path
 from typing import Any
 
-from host.commands.options import add_matcher_options, num_disp_given, params_from_args
+from host.commands.options import (
+    POSITIVE,
+    add_matcher_options,
+    num_disp_given,
+    params_from_args,
+)
 from host.errors import HostError
-from host.files import write_image_atomic
+from host.files import (
+    IMAGE,
+    all_or_nothing,
+    check_folder,
+    check_output,
+    inside,
+    safe_name,
+    write_image_atomic,
+)
 from host.stereo.matcher import compute_disparity, warm_up
 from host.stereo.metrics import evaluate
 from host.stereo.params import MatcherParams
-from host.stereo.picture import colourise
+from host.stereo.picture import picture
 from host.stereo.scenes import Scene, load_scenes
 
 
@@ -24,8 +37,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("scenes", nargs="*", type=Path, metavar="SCENE_DIR",
                    help="scene folders, or folders of them (default: the embedded Motorcycle "
                         "pair)")
-    p.add_argument("--scale", type=float, help="ground-truth scale for 2001/2003 layouts")
-    p.add_argument("--rho", type=float, default=1.0, help="bad-pixel threshold (px)")
+    p.add_argument("--scale", type=POSITIVE, help="ground-truth scale for 2001/2003 layouts")
+    p.add_argument("--rho", type=POSITIVE, default=1.0, help="bad-pixel threshold (px)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--picture", type=Path, metavar="DIR",
                    help="write each scene's disparity picture into DIR")
@@ -52,20 +65,15 @@ def _fmt(v: float | None, spec: str = ".2f") -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.picture:
+        check_folder(args.picture, "--picture")
     params = params_from_args(args)
     scenes = load_scenes(args.scenes, args.scale)
-    rows = []
     for scene in scenes:
         if scene.gt is None:
             raise HostError(f"{scene.name}: no ground truth to evaluate against")
-        p = params if num_disp_given(args) else params.replace(
-            num_disparities=scene.num_disparities(16 if params.matcher.startswith("opencv")
-                                                  else 1))
-        row = score_scene(scene, p, args.rho)
-        if args.picture:
-            write_image_atomic(args.picture / f"{scene.name}.png",
-                               colourise(row["disp"], p.min_disparity + p.num_disparities))
-        rows.append(row)
+    with all_or_nothing():  # the pictures appear together, after every scene was scored
+        rows = [_score(scene, params, args) for scene in scenes]
     out = [{k: (None if isinstance(v, float) and math.isnan(v) else v)
             for k, v in r.items() if k != "disp"} for r in rows]
     if args.json:
@@ -77,3 +85,15 @@ def run(args: argparse.Namespace) -> int:
         print(f"{r['scene']:<16}{_fmt(r['bad']):>8}{_fmt(r['bad_nonocc']):>9}"
               f"{_fmt(r['rms']):>8}{_fmt(r['density']):>10}{_fmt(r['ms'], '.1f'):>9}")
     return 0
+
+
+def _score(scene: Scene, params: MatcherParams, args: argparse.Namespace) -> dict[str, Any]:
+    """Score one scene; with --picture, stage its picture (named from the scene, made safe)."""
+    p = params if num_disp_given(args) else params.replace(
+        num_disparities=scene.num_disparities(16 if params.matcher.startswith("opencv") else 1))
+    row = score_scene(scene, p, args.rho)
+    if args.picture:
+        path = check_output(inside(args.picture, safe_name(scene.name, ".png")), IMAGE,
+                            "--picture")
+        write_image_atomic(path, picture(row["disp"], p.min_disparity + p.num_disparities))
+    return row

@@ -1,29 +1,82 @@
-"""Matcher options shared by the commands that compute disparity (eval, disparity, servo)."""
+"""Options shared by the commands: the matcher's (eval, disparity, tune, servo), and the
+range-checked number types every numeric option uses, so a bad value is refused at parse time
+with a message naming the option ("argument --fps: must be > 0, got 0")."""
 
 from __future__ import annotations
 
 import argparse
+import math
+from collections.abc import Callable
 
 from host.params_file import load_params
 from host.stereo.params import BORDERS, MATCHERS, MatcherParams
 
 
+def _bounds(lo: float | None, hi: float | None, lo_open: bool, hi_open: bool) -> str:
+    parts = []
+    if lo is not None:
+        parts.append(f"{'>' if lo_open else '>='} {lo:g}")
+    if hi is not None:
+        parts.append(f"{'<' if hi_open else '<='} {hi:g}")
+    return " and ".join(parts)
+
+
+def _ranged(kind: type, lo: float | None, hi: float | None, lo_open: bool,
+            hi_open: bool) -> Callable[[str], float]:
+    def parse(text: str):
+        try:
+            value = kind(text)
+        except ValueError:
+            word = "an integer" if kind is int else "a number"
+            raise argparse.ArgumentTypeError(f"expected {word}, got {text!r}") from None
+        if kind is float and not math.isfinite(value):
+            raise argparse.ArgumentTypeError(f"must be a finite number, got {text!r}")
+        if ((lo is not None and (value < lo or (lo_open and value == lo)))
+                or (hi is not None and (value > hi or (hi_open and value == hi)))):
+            raise argparse.ArgumentTypeError(
+                f"must be {_bounds(lo, hi, lo_open, hi_open)}, got {text}")
+        return value
+
+    parse.__name__ = kind.__name__  # argparse names the type in its own messages
+    return parse
+
+
+def int_range(lo: int | None = None, hi: int | None = None) -> Callable[[str], int]:
+    """An argparse type: an integer in [lo, hi] (either bound may be None)."""
+    return _ranged(int, lo, hi, False, False)  # type: ignore[return-value]
+
+
+def float_range(lo: float | None = None, hi: float | None = None, *, lo_open: bool = False,
+                hi_open: bool = False) -> Callable[[str], float]:
+    """An argparse type: a finite number between lo and hi, each bound closed unless *_open."""
+    return _ranged(float, lo, hi, lo_open, hi_open)
+
+
+POSITIVE = float_range(0, lo_open=True)  # > 0
+NON_NEGATIVE = float_range(0)  # >= 0
+FRACTION = float_range(0, 1)  # [0, 1]
+COUNT = int_range(1)  # >= 1
+SEED = int_range(0)  # >= 0
+
+
 def add_matcher_options(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("matcher (defaults: --params file, else the built-in defaults)")
     g.add_argument("--params", metavar="FILE", help="tuned parameters file (host tune --out)")
-    g.add_argument("--matcher", choices=MATCHERS)
-    g.add_argument("--window", type=int, metavar="N", help="block size, odd (px)")
-    g.add_argument("--num-disp", type=int, metavar="N",
+    g.add_argument("--matcher", choices=MATCHERS, help="matching cost, or an OpenCV matcher")
+    g.add_argument("--window", type=int_range(1), metavar="N", help="block size, odd (px)")
+    g.add_argument("--num-disp", type=COUNT, metavar="N",
                    help="number of disparities (default: from the scene's ground truth, else 64)")
     g.add_argument("--min-disp", type=int, metavar="N", help="smallest disparity (px)")
-    g.add_argument("--lr-check", type=float, metavar="PX",
+    g.add_argument("--lr-check", type=NON_NEGATIVE, metavar="PX",
                    help="left-right consistency tolerance (px); off when not given")
-    g.add_argument("--uniqueness", type=float, metavar="PCT", help="uniqueness ratio (%%)")
+    g.add_argument("--uniqueness", type=float_range(0, 100), metavar="PCT",
+                   help="uniqueness ratio (%%)")
     g.add_argument("--border", choices=BORDERS, help="window at the image edge: invalid or clip")
     g.add_argument("--fill", action="store_true", default=None,
                    help="fill invalid pixels from the farther neighbour")
     g.add_argument("--median", type=int, choices=(0, 3, 5), help="median filter size")
-    g.add_argument("--no-subpixel", dest="subpixel", action="store_false", default=None)
+    g.add_argument("--no-subpixel", dest="subpixel", action="store_false", default=None,
+                   help="whole-pixel disparities (no parabola fit)")
     g.add_argument("--grey", dest="colour", action="store_false", default=None,
                    help="match on grey even when the images have colour")
 

@@ -12,8 +12,18 @@ from pathlib import Path
 
 from host.camera.calibration import Calibration, Geometry
 from host.camera.open import add_camera_options, open_source, parse_size
-from host.commands.options import add_matcher_options, params_from_args
-from host.errors import HostError
+from host.camera.source import CameraError
+from host.commands.options import (
+    NON_NEGATIVE,
+    POSITIVE,
+    add_matcher_options,
+    float_range,
+    int_range,
+    params_from_args,
+)
+from host.commands.servo_outcome import outcome
+from host.errors import HostError, NotReached
+from host.files import check_output
 from host.link.client import RobotLink
 from host.servo.controller import ControlConfig
 from host.servo.loop import Servo
@@ -27,22 +37,26 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--port", help="serial port of the robot, or 'emulator'")
     p.add_argument("--log", type=Path, metavar="run.csv", help="write the run's log")
     p.add_argument("--plot", type=Path, metavar="run.png", help="plot trajectory and commands")
-    p.add_argument("--duration", type=float, metavar="S", help="stop after S seconds")
-    p.add_argument("--settle", type=float, default=1.0, metavar="S",
+    p.add_argument("--duration", type=POSITIVE, metavar="S", help="stop after S seconds")
+    p.add_argument("--settle", type=NON_NEGATIVE, default=1.0, metavar="S",
                    help="end after holding at the target this long (0: run on)")
-    p.add_argument("--tolerance-cm", type=float, default=1.0,
+    p.add_argument("--tolerance-cm", type=POSITIVE, default=1.0,
                    help="stop within this depth of the target (converted to px there)")
     p.add_argument("--mode", choices=("turn", "reverse"), default="turn",
                    help="to come back: turn round and drive (the paper) or reverse")
-    p.add_argument("--turn-s", type=float, help="seconds a turn round takes (default: the "
+    p.add_argument("--turn-s", type=POSITIVE, help="seconds a turn round takes (default: the "
                                                 "simulated robot's, 2 s on a real one)")
-    p.add_argument("--max-duty", type=int, default=600)
-    p.add_argument("--min-duty", type=int, default=180, help="least duty that moves the robot")
-    p.add_argument("--marker", choices=("disc", "aruco"), default="disc")
-    p.add_argument("--marker-radius-cm", type=float, default=3.0,
+    p.add_argument("--max-duty", type=int_range(1, 1000), default=600,
+                   help="largest duty while driving (permille)")
+    p.add_argument("--min-duty", type=int_range(0, 1000), default=180,
+                   help="least duty that moves the robot (permille)")
+    p.add_argument("--marker", choices=("disc", "aruco"), default="disc",
+                   help="the robot's marker: a dark disc, or an ArUco tag")
+    p.add_argument("--marker-radius-cm", type=NON_NEGATIVE, default=3.0,
                    help="radius of the marker's dark disc (0: do not check sizes)")
-    p.add_argument("--start-depth", type=float, default=1.9, help="sim: robot's start (m)")
-    p.add_argument("--fps", type=float, default=30.0, help="sim: frame rate")
+    p.add_argument("--start-depth", type=float_range(0.3, 3.0), default=1.9,
+                   help="sim: robot's start (m)")
+    p.add_argument("--fps", type=float_range(1, 1000), default=30.0, help="sim: frame rate")
     add_camera_options(p, sim=True)
     add_matcher_options(p)
     p.set_defaults(run=run)
@@ -74,11 +88,19 @@ class _Status:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.log:
+        check_output(args.log, "csv", "--log")
+    if args.plot:
+        check_output(args.plot, "png", "--plot")
+    if args.min_duty > args.max_duty:
+        raise HostError(f"--min-duty {args.min_duty} exceeds --max-duty {args.max_duty}")
     if args.sim:
         args.camera, args.port = "sim", args.port or "emulator"
     if not args.port:
         raise HostError("--port is needed (a serial port, or 'emulator'); --sim runs it all "
                         "simulated")
+    if args.camera == "sim" and args.port != "emulator":
+        raise HostError("--camera sim needs --port emulator (the simulated robot)")
     params = params_from_args(args)
     with contextlib.ExitStack() as stack:
         emulator, service = None, None
@@ -87,16 +109,15 @@ def run(args: argparse.Namespace) -> int:
 
             emulator = Emulator(line_rate=args.camera != "sim")
             service = stack.enter_context(PtyService(emulator, realtime=args.camera != "sim"))
+        # the port first: a wrong one fails before a camera is opened
+        link = stack.enter_context(RobotLink(service.path if service else args.port))
         if args.camera == "sim":
-            if emulator is None:
-                raise HostError("--camera sim needs --port emulator (the simulated robot)")
             source, world, geometry, clock = _sim(args, emulator)
         else:
             source = stack.enter_context(open_source(args))
             world, clock = None, time.monotonic
             geometry = (Calibration.load(args.calib).geometry if args.calib
                         else Geometry.minoru_default(*parse_size(args.size)))
-        link = stack.enter_context(RobotLink(service.path if service else args.port))
         return _servo(args, params, source, link, geometry, world, clock)
 
 
@@ -129,14 +150,19 @@ def _servo(args, params, source, link, geometry, world, clock) -> int:
     t0 = clock()
     try:
         while True:
-            row = servo.step(world.robot.z_m if world else math.nan)
+            try:
+                row = servo.step(world.robot.z_m if world else math.nan)
+            except CameraError:
+                if not args.camera.startswith("replay:"):
+                    raise
+                break  # the end of a replay ends the run; outcome() tells how it went
             status.show(row)
             if args.duration is not None and clock() - t0 >= args.duration:
                 break
             if args.settle and servo.held_for(args.settle):
                 break
             if world is not None and args.duration is None and clock() - t0 > 60:
-                raise HostError("the simulated robot did not settle within 60 s")
+                raise NotReached("the simulated robot did not settle within 60 s")
     finally:
         status.done()
         if servo.rows:
@@ -144,12 +170,11 @@ def _servo(args, params, source, link, geometry, world, clock) -> int:
                 write_csv(args.log, servo.rows)
             if args.plot:
                 plot_run(args.plot, servo.rows, geometry)
-    last = servo.rows[-1]
-    robot_z = geometry.depth_m(last.robot_px) if last.robot_px > 0 else math.nan
-    msg = (f"held at disparity {last.robot_px:.2f} px ({robot_z:.3f} m) against the target's "
-           f"{target.disparity:.2f} px after {last.t - t0:.1f} s")
+    failed, msg = outcome(servo.rows, geometry.depth_m)
     if world is not None:
         msg += (f"; true robot depth {world.robot.z_m:.3f} m, nearest box "
                 f"{world.nearest_box().z_m:.3f} m")
+    if failed:
+        raise NotReached(msg)
     print(msg, file=sys.stderr)
     return 0

@@ -8,8 +8,18 @@ import json
 import sys
 from pathlib import Path
 
-from host.commands.options import add_matcher_options, num_disp_given, params_from_args
+from host.commands.options import (
+    COUNT,
+    FRACTION,
+    POSITIVE,
+    SEED,
+    add_matcher_options,
+    int_range,
+    num_disp_given,
+    params_from_args,
+)
 from host.errors import HostError
+from host.files import all_or_nothing, check_output
 from host.params_file import save_params
 from host.stereo.scenes import load_scenes
 from host.tuning.learners import METHODS, tune
@@ -23,22 +33,24 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("tune", help="tune the matcher's parameters against ground truth")
     p.add_argument("scenes", nargs="*", type=Path, metavar="SCENE_DIR",
                    help="scenes with ground truth (default: the embedded Motorcycle pair)")
-    p.add_argument("--space", choices=SPACES, default="window")
-    p.add_argument("--method", choices=METHODS, default="paper")
-    p.add_argument("--iterations", type=int,
+    p.add_argument("--space", choices=SPACES, default="window",
+                   help="parameters to tune: the window alone, or a matcher's several")
+    p.add_argument("--method", choices=METHODS, default="paper",
+                   help="the paper's Q-learner, full Q-learning, grid or random search")
+    p.add_argument("--iterations", type=int_range(0),
                    help="learner steps (default: paper 20, qlearning 300, random 60; grid: all)")
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--workers", type=int, default=1, help="parallel evaluation processes")
+    p.add_argument("--seed", type=SEED, default=0, help="seed of the learner")
+    p.add_argument("--workers", type=COUNT, default=1, help="parallel evaluation processes")
     p.add_argument("--windows", default="5:41", help="odd window sizes lo:hi (window space)")
-    p.add_argument("--step", type=int, default=1, help="action step in values of a parameter")
-    p.add_argument("--alpha", type=float, help="qlearning: learning rate (default 0.5)")
-    p.add_argument("--gamma", type=float, help="discount (default: paper 0.8, qlearning 0.9)")
-    p.add_argument("--epsilon", type=float,
+    p.add_argument("--step", type=COUNT, default=1, help="action step in values of a parameter")
+    p.add_argument("--alpha", type=FRACTION, help="qlearning: learning rate (default 0.5)")
+    p.add_argument("--gamma", type=FRACTION, help="discount (default: paper 0.8, qlearning 0.9)")
+    p.add_argument("--epsilon", type=FRACTION,
                    help="exploration (paper 0.2; qlearning 0.3 at the start, decaying)")
-    p.add_argument("--episodes", type=int, help="qlearning: episodes (default 20)")
-    p.add_argument("--tune-on", type=int, metavar="N",
+    p.add_argument("--episodes", type=COUNT, help="qlearning: episodes (default 20)")
+    p.add_argument("--tune-on", type=COUNT, metavar="N",
                    help="tune on the first N scenes, report the others as held out")
-    p.add_argument("--scale", type=float, help="ground-truth scale for 2001/2003 layouts")
+    p.add_argument("--scale", type=POSITIVE, help="ground-truth scale for 2001/2003 layouts")
     p.add_argument("--out", type=Path, metavar="PARAMS.toml", help="write the tuned parameters")
     p.add_argument("--plot", type=Path, metavar="FIG.png", help="Figure 9 and the Q table")
     p.add_argument("--json", action="store_true", help="print one JSON object")
@@ -55,11 +67,13 @@ def _progress(total: int, enabled: bool):
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.out:
+        check_output(args.out, "toml", "--out")
+    if args.plot:
+        check_output(args.plot, "png", "--plot")
     iterations = DEFAULT_ITERATIONS[args.method] if args.iterations is None else args.iterations
     if args.method != "grid" and iterations < 1:
         raise HostError(f"--iterations must be at least 1, got {iterations}")
-    if args.workers < 1:
-        raise HostError(f"--workers must be at least 1, got {args.workers}")
     scenes = load_scenes(args.scenes, args.scale)
     for s in scenes:
         if s.gt is None:
@@ -86,12 +100,6 @@ def run(args: argparse.Namespace) -> int:
         raise HostError("--alpha and --episodes belong to --method qlearning")
     if args.method in ("grid", "random") and set(hyper) - {"step"}:
         raise HostError(f"--method {args.method} takes no learning parameters")
-    if args.step < 1 or (args.episodes is not None and args.episodes < 1):
-        raise HostError("--step and --episodes must be at least 1")
-    for name in ("alpha", "gamma", "epsilon"):
-        value = getattr(args, name)
-        if value is not None and not 0.0 <= value <= 1.0:
-            raise HostError(f"--{name} must be in [0, 1], got {value}")
     obj = Objective.on_scenes(tuned_on, space.params, workers=args.workers)
     total = space.size if args.method == "grid" else iterations
     bar = _progress(total, not args.json and sys.stderr.isatty())
@@ -104,16 +112,17 @@ def run(args: argparse.Namespace) -> int:
             bar.close()
     best = space.params(result.best_state)
     held = {s.name: mean_bad([s], best) for s in held_out}
-    if args.out:
-        save_params(args.out, best, {
-            "method": args.method, "space": args.space, "seed": args.seed,
-            "scenes": [s.name for s in tuned_on], "bad": round(result.best_bad, 4),
-            "evaluations": result.evaluations,
-            "date": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")})
-    if args.plot:
-        from host.tuning.plot import plot
+    with all_or_nothing():  # both outputs, or neither
+        if args.out:
+            save_params(args.out, best, {
+                "method": args.method, "space": args.space, "seed": args.seed,
+                "scenes": [s.name for s in tuned_on], "bad": round(result.best_bad, 4),
+                "evaluations": result.evaluations,
+                "date": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")})
+        if args.plot:
+            from host.tuning.plot import plot
 
-        plot(result, args.plot)
+            plot(result, args.plot)
     out = result.to_json() | {"scenes": [s.name for s in tuned_on], "held_out": held}
     if args.json:
         print(json.dumps(out, default=str))

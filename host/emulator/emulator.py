@@ -51,6 +51,8 @@ class Emulator:
         self._tx_free_ms = 0.0    # when the line to the host is free again
         self._ticked_ms = 0
         self.lock = threading.RLock()
+        record = os.environ.get("HOST_EMULATOR_RECORD")  # test hook: keep what the host sent
+        self._record = open(record, "ab", buffering=0) if record else None  # noqa: SIM115
         self._collect()
 
     @property
@@ -71,6 +73,8 @@ class Emulator:
     def receive(self, data: bytes) -> None:
         """Bytes the host wrote, starting on the line now."""
         with self.lock:
+            if self._record:
+                self._record.write(data)
             if self.silent:
                 return
             for b in self._faulty(data):

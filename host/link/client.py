@@ -42,6 +42,7 @@ class RobotLink:
         self.expected_hash = expected_hash
         self.hello: Any = None
         self.duplicates = 0  # resends the robot had already applied
+        self.received_bytes = 0  # every byte read, frame or not (the handshake reports it)
         self._ser: serial.Serial | None = None
         self._dec = FrameDecoder()
         self._seq = random.randrange(256)
@@ -73,6 +74,7 @@ class RobotLink:
             data = self._ser.read(max(1, self._ser.in_waiting))
         except (serial.SerialException, OSError) as e:
             raise LinkError(f"lost the serial port {self.port}: {_reason(e)}") from None
+        self.received_bytes += len(data)
         out = []
         for f in self._dec.feed(data):
             try:
@@ -100,10 +102,19 @@ class RobotLink:
         # until the reply with this nonce comes or handshake_s runs out.
         nonce = random.getrandbits(32)
         deadline = time.monotonic() + self.handshake_s
+        dec = self._dec
+        good0, bad0 = dec.good_frames, dec.crc_errors + dec.framing_errors
+        bytes0 = self.received_bytes
+        read = [0, 0]  # frames that decoded to a message of this host's spec; of them, HELLOs
+
+        def is_reply(m: Any) -> bool:
+            read[0] += 1
+            read[1] += isinstance(m, gen.Hello)  # our own HELLO: the line echoes
+            return isinstance(m, gen.HelloReply) and m.nonce == nonce
+
         while time.monotonic() < deadline:
             self._write(encode_frame(self._next_seq(), *pack(gen.Hello(nonce=nonce))))
-            reply = self._await(lambda m: isinstance(m, gen.HelloReply) and m.nonce == nonce,
-                                min(0.25, max(0.0, deadline - time.monotonic())))
+            reply = self._await(is_reply, min(0.25, max(0.0, deadline - time.monotonic())))
             if reply is None:
                 continue
             if reply.schema_hash != self.expected_hash:
@@ -112,8 +123,11 @@ class RobotLink:
                                 f"{self.expected_hash:08X}; flash the firmware built from this "
                                 f"checkout")
             return reply
-        raise LinkError(f"no answer from a robot on {self.port} within {self.handshake_s:g} s "
-                        f"(is the firmware flashed and the port right?)")
+        good, bad = dec.good_frames - good0, dec.crc_errors + dec.framing_errors - bad0
+        noise = self.received_bytes - bytes0
+        raise LinkError(f"no answer from a robot on {self.port} within "
+                        f"{self.handshake_s:g} s: "
+                        f"{_seen(noise, good, bad, good - read[0], read[1], self.baud)}")
 
     def _next_seq(self) -> int:
         self._seq = (self._seq + 1) & 0xFF
@@ -195,3 +209,19 @@ def _reason(e: BaseException) -> str:
     if "Permission denied" in text or "[Errno 13]" in text:
         return "permission denied (add yourself to the dialout group)"
     return text.splitlines()[0]
+
+
+def _seen(nbytes: int, good: int, bad: int, unreadable: int, echoed: int, baud: int) -> str:
+    """What arrived during a failed handshake, and what that suggests."""
+    if unreadable:
+        return (f"{unreadable} frame(s) arrived that this host cannot read: a robot built from "
+                f"another protocol spec? flash the firmware built from this checkout")
+    if good and echoed == good:
+        return "only our own HELLO came back: the line echoes (a loopback, not the robot)"
+    if good:
+        return f"{good} frame(s) arrived but none answered HELLO"
+    if nbytes:
+        return (f"only garbled frames arrived ({nbytes} bytes, {bad} frame(s) with a bad CRC "
+                f"or length): a wrong baud rate (the robot talks at {baud}), a noisy line, or "
+                f"another device on the port")
+    return "nothing arrived (is the firmware flashed, the robot powered and the port right?)"

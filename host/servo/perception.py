@@ -9,6 +9,7 @@ median) over that region, not a single pixel.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import cv2
@@ -105,7 +106,8 @@ def nearest_object(disp: np.ndarray, min_area: int, step: float = 0.5) -> Target
 def reference_target(disps: list[np.ndarray], min_area: int) -> tuple[Target, Floor | None]:
     """Target from several disparity maps of the scene without the robot (per-pixel median)."""
     stack = np.stack(disps)
-    with np.errstate(all="ignore"):
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # pixels invalid in every map stay NaN
         median = np.nanmedian(stack, axis=0) if len(disps) > 1 else stack[0]
     floor = fit_floor(median)
     return nearest_object(without_floor(median, floor), min_area), floor

@@ -41,6 +41,8 @@ class Scene:
 
 
 def read_image(path: Path, flags: int = cv2.IMREAD_COLOR) -> np.ndarray:
+    if path.is_dir():
+        raise HostError(f"{path}: is a folder, not an image")
     if not path.is_file():
         raise HostError(f"{path}: no such file")
     img = cv2.imread(str(path), flags)
@@ -80,8 +82,13 @@ def _load_shared(d: Path) -> Scene:
     try:
         meta = json.loads((d / "meta.json").read_text())
         scale = float(meta["scale"])
-    except (OSError, ValueError, KeyError) as e:
+    except (OSError, ValueError, KeyError, TypeError) as e:
         raise HostError(f"{d / 'meta.json'}: unreadable or lacks 'scale' ({e})") from None
+    top = meta.get("max_disparity")
+    if not (np.isfinite(scale) and scale > 0) or not isinstance(meta.get("scene", ""), str) \
+            or not (top is None or (isinstance(top, (int, float)) and 0 < top < 1e4)):
+        raise HostError(f"{d / 'meta.json'}: needs a positive 'scale', and a text 'scene' and a "
+                        f"positive 'max_disparity' where given")
     masks = {k: _mask(d / f"{k}.png") for k in ("nonocc", "all") if (d / f"{k}.png").exists()}
     if (d / "disc.png").exists():
         masks["disc"] = _mask(d / "disc.png")

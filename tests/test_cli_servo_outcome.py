@@ -1,0 +1,59 @@
+"""host servo's exit status tells how the run ended: held (0), or not reached (3) with the
+reason: the marker never seen, or a safe stop at the end."""
+
+from __future__ import annotations
+
+import math
+import warnings
+from pathlib import Path
+
+import cv2
+import pytest
+
+from host.cli import main
+from host.commands.servo_outcome import NOT_REACHED, outcome
+from host.servo.loop import LogRow
+
+
+def _row(t: float, phase: str, robot_px: float = math.nan) -> LogRow:
+    return LogRow(t, phase, 20.0, robot_px, robot_px, math.nan, 0, 0, 30.0, 1.0)
+
+
+def _depth(d: float) -> float:
+    return 25.0 / d
+
+
+@pytest.mark.parametrize("rows, status, words", [
+    ([_row(0, "hold"), _row(1, "lost")], NOT_REACHED, "never seen in 2 frames"),
+    ([_row(0, "drive", 18.0), _row(1, "lost")], NOT_REACHED, "safe stop after 1.0 s: the "
+                                                              "marker was lost"),
+    ([_row(0, "drive", 18.0), _row(1, "stale")], NOT_REACHED, "too late"),
+    ([_row(0, "drive", 18.0), _row(1, "hold", 20.1)], 0, "held at disparity 20.10 px"),
+    ([_row(0, "drive", 18.0), _row(1, "drive", 19.0)], 0, "stopped while in phase drive"),
+    ([], NOT_REACHED, "before the robot phase"),
+])
+def test_outcome_of_a_run(rows: list[LogRow], status: int, words: str) -> None:
+    got, message = outcome(rows, _depth)
+    assert got == status and words in message and "nan" not in message
+
+
+def test_a_replay_without_the_marker_exits_3_with_the_reason(tmp_path: Path, capsys) -> None:
+    from host.servo.world import World
+
+    world = World.for_size(320, 240)
+    for i in range(8):  # five reference frames, then three in which no robot appears
+        frame, _ = world.render(i / 30, with_robot=False)
+        cv2.imwrite(str(tmp_path / f"left_{i:03d}.png"), frame.left)
+        cv2.imwrite(str(tmp_path / f"right_{i:03d}.png"), frame.right)
+    log = tmp_path / "run.csv"
+    with warnings.catch_warnings(record=True) as caught:  # e.g. numpy's "All-NaN slice"
+        warnings.simplefilter("always")
+        assert main(["servo", "--camera", f"replay:{tmp_path}", "--port", "emulator",
+                     "--num-disp", "48", "--log", str(log)]) == NOT_REACHED
+    assert [str(w.message) for w in caught if w.category is RuntimeWarning] == []
+    err = capsys.readouterr().err
+    assert err.splitlines()[-1] == ("host servo: not reached: the marker was never seen in 3 "
+                                    "frames (check --marker and that the robot's marker faces "
+                                    "the cameras)")
+    assert "nan" not in err
+    assert len(log.read_text().splitlines()) == 4

@@ -1,0 +1,52 @@
+"""host servo ended by SIGTERM or SIGHUP does what Ctrl-C does: STOP reaches the robot, the
+log is kept, and the exit status is 128+n."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from host.link import protocol_gen as gen
+from host.link.frame import FrameDecoder
+
+
+def _messages_received(record: Path) -> list[int]:
+    """Message ids of the frames the emulator received from the host, in order."""
+    return [f.id for f in FrameDecoder().feed(record.read_bytes())]
+
+
+@pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGHUP])
+def test_a_signal_stops_the_robot_and_keeps_the_log(tmp_path: Path, signum: int) -> None:
+    record, log, plot = tmp_path / "received.bin", tmp_path / "run.csv", tmp_path / "run.png"
+    env = os.environ | {"HOST_EMULATOR_RECORD": str(record)}
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "host", "servo", "--sim", "--border", "clip", "--num-disp", "48",
+         "--settle", "0", "--duration", "120", "--log", str(log),
+         "--plot", str(plot)],
+        stderr=subprocess.PIPE, text=True, env=env, cwd=tmp_path)
+    try:
+        assert proc.stderr is not None
+        first = proc.stderr.readline()  # printed once the reference phase is over
+        assert first.startswith("target:"), first
+        time.sleep(1.0)  # the robot is driving now
+        proc.send_signal(signum)
+        rest = proc.stderr.read()
+        status = proc.wait(timeout=60)
+    finally:
+        proc.kill()
+    assert status == 128 + signum, rest
+    assert rest.splitlines() == [f"host servo: interrupted ({signal.Signals(signum).name})"]
+    ids = _messages_received(record)
+    set_drive, stop = gen.SetDrive.ID, gen.Stop.ID
+    assert set_drive in ids, "the robot was never driven before the signal"
+    last_drive = len(ids) - 1 - ids[::-1].index(set_drive)
+    assert stop in ids[last_drive + 1:], "no STOP after the last SET_DRIVE"
+    rows = log.read_text().splitlines()
+    assert rows[0].startswith("t,phase") and len(rows) > 2
+    assert plot.read_bytes().startswith(b"\x89PNG")
