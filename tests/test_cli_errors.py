@@ -117,7 +117,7 @@ ROWS = [
     (["eval", "--picture", "{tmp}/none"], "--picture {tmp}/none: no such folder"),
     (["calibrate", "{replay}", "--out", "{ro}/calib.yml"], "cannot write in folder"),
     (["capture", "--out", "{ro}"], "--out {ro}: cannot write in folder"),
-    (["capture", "--out", "{ro}/shots"], "--out {ro}/shots: cannot make the folder"),
+    (["capture", "--out", "{ro}/shots"], "--out {ro}/shots: cannot write in folder"),
     (["capture", "--out", "{l}"], "not a folder"),
     # inputs: images
     (["disparity", "{colour}", "{r}", "-o", "{tmp}/o.png"], "is colour and"),

@@ -26,8 +26,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.out.exists() and (not args.out.is_dir() or any(args.out.glob("left_*"))):
-        raise HostError(f"{args.out} already holds pairs (or is a file): choose another --out")
+    if args.out.exists() and not args.out.is_dir():
+        raise HostError(f"--out {args.out}: not a folder")
+    if args.out.is_dir() and any(args.out.glob("left_*")):
+        raise HostError(f"--out {args.out}: already holds pairs; choose another folder")
     # writable now, but made only once the camera delivers (nothing left behind on failure)
     existing = next(p for p in (args.out, *args.out.parents) if p.exists())
     check_folder(existing, "--out", target=args.out)
