@@ -5,11 +5,11 @@ from __future__ import annotations
 import argparse
 import sys
 
-from host.commands import calibrate, capture, disparity, emulate, servo, tune
+from host.commands import calibrate, capture, disparity, emulate, servo, tune, view
 from host.commands import eval as eval_cmd
 from host.errors import HostError
 
-COMMANDS = [eval_cmd, disparity, tune, capture, calibrate, servo, emulate]
+COMMANDS = [eval_cmd, disparity, tune, capture, calibrate, servo, emulate, view]
 
 
 class _Parser(argparse.ArgumentParser):

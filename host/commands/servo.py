@@ -13,6 +13,7 @@ from pathlib import Path
 from host.camera.calibration import Calibration, Geometry
 from host.camera.open import add_camera_options, open_source, parse_size
 from host.commands.options import add_matcher_options, params_from_args
+from host.commands.view import add_view_option, open_view
 from host.errors import HostError
 from host.link.client import RobotLink
 from host.servo.controller import ControlConfig
@@ -45,6 +46,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--fps", type=float, default=30.0, help="sim: frame rate")
     add_camera_options(p, sim=True)
     add_matcher_options(p)
+    add_view_option(p)
     p.set_defaults(run=run)
 
 
@@ -119,6 +121,11 @@ def _servo(args, params, source, link, geometry, world, clock) -> int:
         marker=args.marker, clock=clock,
         marker_radius_m=args.marker_radius_cm / 100 if args.marker_radius_cm else None,
         tolerance_m=args.tolerance_cm / 100)
+    with open_view(args.view, servo):
+        return _run_servo(args, servo, link, geometry, world, clock)
+
+
+def _run_servo(args, servo, link, geometry, world, clock) -> int:
     target = servo.reference()
     z = geometry.depth_m(target.disparity)
     tol = servo.control.tolerance_px
@@ -131,6 +138,8 @@ def _servo(args, params, source, link, geometry, world, clock) -> int:
         while True:
             row = servo.step(world.robot.z_m if world else math.nan)
             status.show(row)
+            if servo.stop_reason is not None:
+                break
             if args.duration is not None and clock() - t0 >= args.duration:
                 break
             if args.settle and servo.held_for(args.settle):
@@ -146,10 +155,14 @@ def _servo(args, params, source, link, geometry, world, clock) -> int:
                 plot_run(args.plot, servo.rows, geometry)
     last = servo.rows[-1]
     robot_z = geometry.depth_m(last.robot_px) if last.robot_px > 0 else math.nan
-    msg = (f"held at disparity {last.robot_px:.2f} px ({robot_z:.3f} m) against the target's "
+    verb = "held" if servo.stop_reason is None else f"stopped ({servo.stop_reason})"
+    msg = (f"{verb} at disparity {last.robot_px:.2f} px ({robot_z:.3f} m) against the target's "
            f"{target.disparity:.2f} px after {last.t - t0:.1f} s")
     if world is not None:
         msg += (f"; true robot depth {world.robot.z_m:.3f} m, nearest box "
                 f"{world.nearest_box().z_m:.3f} m")
     print(msg, file=sys.stderr)
+    if servo.stop_reason is not None:
+        robot = link.status()
+        print(f"the robot reports duty {robot.left} {robot.right} after STOP", file=sys.stderr)
     return 0
