@@ -61,6 +61,7 @@ class ViewServer:
         self.token = None if is_loopback(host) else secrets.token_urlsafe(18)
         self.stops = 0  # STOP presses accepted
         self.connections: list[dict[str, float]] = []  # per page: updates, bytes, seconds
+        self._sockets: set[web.WebSocketResponse] = set()
         self._loop = asyncio.new_event_loop()
         self._runner: web.AppRunner | None = None
         self._thread = threading.Thread(target=self._loop.run_forever, name="view-server",
@@ -77,6 +78,7 @@ class ViewServer:
         app.router.add_get("/", self._page)
         app.router.add_get("/updates", self._updates)
         app.router.add_post("/stop", self._stop)
+        app.on_shutdown.append(self._close_pages)
         return app
 
     # ------------------------------------------------------------------------ life
@@ -114,6 +116,11 @@ class ViewServer:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
+    async def _close_pages(self, app: web.Application) -> None:
+        """The run is over: tell the pages (they say so), rather than leave them waiting."""
+        for ws in list(self._sockets):
+            await ws.close(message=b"the run has ended")
+
     # ------------------------------------------------------------------------ handlers
 
     @web.middleware
@@ -150,6 +157,7 @@ class ViewServer:
         await ws.prepare(request)
         stats = {"updates": 0.0, "bytes": 0.0, "seconds": 0.0}
         self.connections.append(stats)
+        self._sockets.add(ws)
         t0, seq, t_last = time.monotonic(), 0, -1e300
         self.feed.watch(True)
         try:
@@ -171,12 +179,16 @@ class ViewServer:
                     "bytes_per_s": stats["bytes"] / elapsed if elapsed > 0 else None},
                     can_stop=self.on_stop is not None)
                 text = json.dumps(state, allow_nan=False)
-                await ws.send_str(text)
-                for image in update.images:
-                    await ws.send_bytes(image)
+                try:
+                    await ws.send_str(text)
+                    for image in update.images:
+                        await ws.send_bytes(image)
+                except ConnectionResetError:  # the page went away meanwhile
+                    break
                 stats["updates"] += 1
                 stats["bytes"] += len(text) + sum(len(i) for i in update.images)
                 stats["seconds"] = time.monotonic() - t0
         finally:
+            self._sockets.discard(ws)
             self.feed.watch(False)
         return ws
