@@ -138,7 +138,7 @@ def _run_servo(args, servo, link, geometry, world, clock) -> int:
         while True:
             row = servo.step(world.robot.z_m if world else math.nan)
             status.show(row)
-            if servo.stop_reason is not None:
+            if row.phase == "stopped":  # STOP pressed in the view
                 break
             if args.duration is not None and clock() - t0 >= args.duration:
                 break

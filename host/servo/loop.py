@@ -67,8 +67,8 @@ class Servo:
         self.stop_reason: str | None = None  # set by request_stop; the robot stays stopped
 
     def request_stop(self, reason: str) -> None:
-        """Stop the robot at the next frame and keep it stopped (any thread may call this);
-        the caller's loop ends when it sees stop_reason."""
+        """Stop the robot at the next frame (any thread may call this); that step's phase is
+        "stopped", and the caller's loop ends there."""
         self.stop_reason = reason
 
     def _notify(self, frame, phase: str, reason: str, disp, y0: int, pair, row,
@@ -117,6 +117,7 @@ class Servo:
     def step(self, truth_depth_m: float = math.nan) -> LogRow:
         """One frame of the robot phase: perceive, decide, command, log."""
         assert self.controller is not None and self.target is not None
+        stop_reason = self.stop_reason  # read once: a STOP pressed meanwhile acts next frame
         last = self.rows[-1].t if self.rows else None
         frame = self._frame()
         t_wall = time.perf_counter()
@@ -140,7 +141,7 @@ class Servo:
         cmd = self.controller.update(obs)
         if stale:
             cmd = Command(0, 0, "stale", cmd.error)
-        if self.stop_reason is not None:
+        if stop_reason is not None:
             cmd = Command(0, 0, "stopped", cmd.error)
         t_send = time.perf_counter()
         self._send(cmd)
@@ -150,8 +151,8 @@ class Servo:
                      math.nan if cmd.error is None else cmd.error, cmd.left, cmd.right, hz,
                      (time.perf_counter() - t_wall) * 1000, truth_depth_m)
         self.rows.append(row)
-        self._notify(frame, cmd.phase, self.stop_reason or _why_stopped(cmd), *self._map, pair,
-                     row, rtt_ms)
+        self._notify(frame, cmd.phase, stop_reason or _why_stopped(cmd), *self._map, pair, row,
+                     rtt_ms)
         return row
 
     def _send(self, cmd: Command) -> None:

@@ -115,6 +115,11 @@ class ViewFeed:
             finally:
                 self._waiting -= 1
 
+    @property
+    def latest_seq(self) -> int:
+        """The number of the newest snapshot."""
+        return self._seq
+
     def close(self) -> None:
         with self._cond:
             self._closed = True

@@ -101,6 +101,11 @@ class ViewServer:
         self.port = site._server.sockets[0].getsockname()[1]  # type: ignore[union-attr]
 
     def close(self) -> None:
+        """Let the pages have the last step (up to a second), then close them and stop."""
+        deadline = time.monotonic() + 1.0
+        while time.monotonic() < deadline and any(
+                c["open"] and c["seq"] < self.feed.latest_seq for c in self.connections):
+            time.sleep(0.02)
         if self._runner is not None and self._thread.is_alive():
             future = asyncio.run_coroutine_threadsafe(self._runner.cleanup(), self._loop)
             with contextlib.suppress(Exception):  # closing anyway; pages see the socket go
@@ -155,7 +160,7 @@ class ViewServer:
         text message, then its pictures as binary messages."""
         ws = web.WebSocketResponse(heartbeat=10)
         await ws.prepare(request)
-        stats = {"updates": 0.0, "bytes": 0.0, "seconds": 0.0}
+        stats = {"updates": 0.0, "bytes": 0.0, "seconds": 0.0, "seq": 0, "open": True}
         self.connections.append(stats)
         self._sockets.add(ws)
         t0, seq, t_last = time.monotonic(), 0, -1e300
@@ -188,7 +193,9 @@ class ViewServer:
                 stats["updates"] += 1
                 stats["bytes"] += len(text) + sum(len(i) for i in update.images)
                 stats["seconds"] = time.monotonic() - t0
+                stats["seq"] = seq
         finally:
             self._sockets.discard(ws)
+            stats["open"] = False
             self.feed.watch(False)
         return ws
