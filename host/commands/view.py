@@ -68,14 +68,20 @@ def run(args: argparse.Namespace) -> int:
                     else Geometry.minoru_default(*parse_size(args.size)))
         view = stack.enter_context(open_view(args.view))
         t0 = time.monotonic()
+
+        def time_left() -> bool:
+            return args.duration is None or time.monotonic() - t0 < args.duration
+
         last = None
         for frame in source:
             disp = compute_disparity(frame.left, frame.right, params)
             last = find_marker(frame.left, frame.right, "disc", None, geometry.baseline_m, last)
             view.feed(Snapshot(time.monotonic() - t0, "view", "no robot: looking only",
                                frame.left, disp, 0, None, last, None, None, geometry))
-            if args.duration is not None and time.monotonic() - t0 >= args.duration:
-                break
-        else:
-            print("host view: the camera ended", file=sys.stderr)
+            if not time_left():
+                return 0
+        print("host view: the camera ended; the page shows its last frame (Ctrl-C to quit)",
+              file=sys.stderr, flush=True)
+        while time_left():
+            time.sleep(0.1)
     return 0
