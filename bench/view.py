@@ -1,7 +1,11 @@
 """Benchmark of the live view's cost to the servo loop: loop rate at 640x480 (or --size) with
 no view, with the view but no page, and with a page connected (a separate process that asks for
 updates as fast as they come, as a browser does), runs interleaved to show the noise; and the
-page's update rate and bytes per second. The emulator answers on a pty in real time."""
+page's update rate and bytes per second. The emulator answers on a pty in real time.
+
+On a shared machine the wall-clock rate follows the load more than anything; the CPU time the
+loop's own thread spends a step, and the whole process's (the view's threads included, the
+page's process not), say what the view costs regardless of the load."""
 
 from __future__ import annotations
 
@@ -49,11 +53,13 @@ def measure(size: tuple[int, int], params: MatcherParams, frames: int, view: str
                 time.sleep(0.01)
         load0 = os.getloadavg()[0]
         busy = 0.0
-        t0 = time.perf_counter()
+        t0, cpu0, loop_cpu0 = time.perf_counter(), time.process_time(), time.thread_time()
         for _ in range(frames):
             busy += servo.step().latency_ms / 1000
         wall = time.perf_counter() - t0
-        out = {"loop_hz": frames / wall, "processing_hz": frames / busy, "load": load0}
+        out = {"loop_hz": frames / wall, "processing_hz": frames / busy, "load": load0,
+               "loop_cpu_ms": (time.thread_time() - loop_cpu0) / frames * 1000,
+               "cpu_ms": (time.process_time() - cpu0) / frames * 1000}
         if server is not None and feed is not None:
             if page is not None:
                 stats = server.connections[0]
@@ -114,13 +120,17 @@ def main() -> int:
                 extra = (f"; page {m['page_hz']:.1f} updates/s, {m['page_bytes_s'] / 1000:.0f} "
                          f"kB/s, dropped {m['dropped']} of {m['snapshots']}")
             print(f"  round {r + 1} {view:>4}: loop {m['loop_hz']:5.1f} Hz (processing alone "
-                  f"{m['processing_hz']:5.1f} Hz), load {m['load']:.2f}{extra}", flush=True)
+                  f"{m['processing_hz']:5.1f} Hz); CPU a step: loop thread "
+                  f"{m['loop_cpu_ms']:5.1f} ms, whole process {m['cpu_ms']:5.1f} ms; load "
+                  f"{m['load']:.2f}{extra}", flush=True)
     print(f"uptime at end: {_uptime()}")
     for view, ms in results.items():
         hz = [m["loop_hz"] for m in ms]
         sd = statistics.stdev(hz) if len(hz) > 1 else 0.0
         print(f"{view:>4}: loop rate median {statistics.median(hz):5.1f} Hz, "
-              f"range {min(hz):5.1f}-{max(hz):5.1f}, sd {sd:.1f}")
+              f"range {min(hz):5.1f}-{max(hz):5.1f}, sd {sd:.1f}; CPU a step: loop thread "
+              f"{statistics.median(m['loop_cpu_ms'] for m in ms):5.1f} ms, process "
+              f"{statistics.median(m['cpu_ms'] for m in ms):5.1f} ms")
     pages = results["page"]
     print(f"page: {statistics.median(m['page_hz'] for m in pages):.1f} updates/s, "
           f"{statistics.median(m['page_bytes_s'] for m in pages) / 1000:.0f} kB/s")
