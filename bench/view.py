@@ -108,11 +108,13 @@ def main() -> int:
     warm_up(params)
     print(f"{size[0]}x{size[1]}, matcher {params.matcher} window {params.block_size}, "
           f"{params.num_disparities} disparities, marker band; {args.frames} frames a run, "
-          f"{args.rounds} interleaved rounds; {os.cpu_count()} cores shared with other users")
+          f"{args.rounds} interleaved rounds in rotated order; {os.cpu_count()} cores shared "
+          "with other users")
     print(f"uptime at start: {_uptime()}")
     results: dict[str, list[dict]] = {"none": [], "idle": [], "page": []}
     for r in range(args.rounds):
-        for view in results:
+        names = list(results)
+        for view in names[r % 3:] + names[:r % 3]:  # each condition first in some round
             m = measure(size, params, args.frames, view)
             results[view].append(m)
             extra = ""
