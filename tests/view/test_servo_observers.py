@@ -47,3 +47,18 @@ def test_observers_see_every_step_and_stop_is_sent():
         assert seen[-1].phase == "stopped" and seen[-1].reason == "pressed"
         assert link.status().left == 0 and emulator.motors() == (0, 0)
     assert not any(np.shares_memory(s.left, t.left) for s, t in zip(seen, seen[1:]))
+
+
+def test_link_stats_count_resends_and_nacks_on_a_faulty_line():
+    from host.emulator.emulator import Faults
+    from host.servo.snapshot import link_stats
+
+    emulator = Emulator(Faults(corrupt=0.03, seed=3))
+    with PtyService(emulator, realtime=True) as service, RobotLink(service.path) as link:
+        clean = link_stats(link, 1.0)
+        for i in range(12):
+            link.drive(100 + i, 100 + i)
+        stats = link_stats(link, 2.0)
+    assert clean.resends == 0 and clean.nacks == 0
+    assert stats.resends > 0 and stats.resends >= stats.nacks
+    assert stats.rtt_ms == 2.0 and stats.schema_hash == clean.schema_hash
