@@ -10,7 +10,7 @@ DATA ?= $(abspath ../shared/data)
 # tests and benchmarks find the Middlebury scenes through this variable
 export STEREO_SERVO_DATA ?= $(if $(wildcard $(DATA)/middlebury/index.json),$(DATA),)
 
-.PHONY: demo test lint bench venv system-deps protocol firmware flash clean
+.PHONY: demo test lint bench venv system-deps browser-deps protocol firmware flash clean
 
 $(BIN)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -22,6 +22,10 @@ venv: $(BIN)/.installed
 system-deps:
 	@bash tools/system-deps.sh
 
+# Debian's chromium for the live view's browser test (tests/view)
+browser-deps:
+	@bash tools/browser-deps.sh
+
 demo: venv
 	@mkdir -p $(OUT)
 	$(BIN)/host eval --picture $(OUT)
@@ -30,7 +34,7 @@ demo: venv
 	$(BIN)/host servo --sim --border clip --num-disp 48 --log $(OUT)/servo.csv --plot $(OUT)/servo.png
 	@echo "pictures: $(OUT)/motorcycle.png (disparity), $(OUT)/tuning.png (tuning), $(OUT)/servo.png (servo run)"
 
-test: venv system-deps lint
+test: venv system-deps browser-deps lint
 	$(BIN)/python -m pytest
 
 lint: venv

@@ -24,6 +24,7 @@ from host.commands.options import (
 from host.commands.servo_outcome import outcome
 from host.errors import HostError, NotReached
 from host.files import check_output
+from host.commands.view import add_view_option, open_view
 from host.link.client import RobotLink
 from host.servo.controller import ControlConfig
 from host.servo.loop import Servo
@@ -59,6 +60,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--fps", type=float_range(1, 1000), default=30.0, help="sim: frame rate")
     add_camera_options(p, sim=True)
     add_matcher_options(p)
+    add_view_option(p)
     p.set_defaults(run=run)
 
 
@@ -140,6 +142,11 @@ def _servo(args, params, source, link, geometry, world, clock) -> int:
         marker=args.marker, clock=clock,
         marker_radius_m=args.marker_radius_cm / 100 if args.marker_radius_cm else None,
         tolerance_m=args.tolerance_cm / 100)
+    with open_view(args.view, servo):
+        return _run_servo(args, servo, link, geometry, world, clock)
+
+
+def _run_servo(args, servo, link, geometry, world, clock) -> int:
     target = servo.reference()
     z = geometry.depth_m(target.disparity)
     tol = servo.control.tolerance_px
@@ -157,6 +164,8 @@ def _servo(args, params, source, link, geometry, world, clock) -> int:
                     raise
                 break  # the end of a replay ends the run; outcome() tells how it went
             status.show(row)
+            if row.phase == "stopped":  # STOP pressed in the view
+                break
             if args.duration is not None and clock() - t0 >= args.duration:
                 break
             if args.settle and servo.held_for(args.settle):
@@ -170,11 +179,14 @@ def _servo(args, params, source, link, geometry, world, clock) -> int:
                 write_csv(args.log, servo.rows)
             if args.plot:
                 plot_run(args.plot, servo.rows, geometry)
-    failed, msg = outcome(servo.rows, geometry.depth_m)
+    failed, msg = outcome(servo.rows, geometry.depth_m, servo.stop_reason)
     if world is not None:
         msg += (f"; true robot depth {world.robot.z_m:.3f} m, nearest box "
                 f"{world.nearest_box().z_m:.3f} m")
     if failed:
         raise NotReached(msg)
     print(msg, file=sys.stderr)
+    if servo.stop_reason is not None:
+        robot = link.status()
+        print(f"the robot reports duty {robot.left} {robot.right} after STOP", file=sys.stderr)
     return 0

@@ -15,8 +15,10 @@ _SAFE_STOPS = {"lost": "the marker was lost", "stale": "frames came too late (st
                "hold": "the marker was not seen in the last frame"}
 
 
-def outcome(rows: Sequence, depth_m: Callable[[float], float]) -> tuple[int, str]:
-    """(exit status, message) for the log rows of a run; depth_m turns disparity into metres."""
+def outcome(rows: Sequence, depth_m: Callable[[float], float],
+            stop_reason: str | None = None) -> tuple[int, str]:
+    """(exit status, message) for the log rows of a run; depth_m turns disparity into metres;
+    stop_reason is why the user stopped the run (the view's STOP), which is no failure."""
     if not rows:
         return NOT_REACHED, "the run ended before the robot phase began"
     target = rows[0].target_px
@@ -32,6 +34,8 @@ def outcome(rows: Sequence, depth_m: Callable[[float], float]) -> tuple[int, str
                              f"against the target's {target:.2f} px")
     where = (f"disparity {last.robot_px:.2f} px ({depth_m(last.robot_px):.3f} m) against the "
              f"target's {target:.2f} px {after}")
+    if stop_reason is not None:
+        return 0, f"stopped ({stop_reason}) at {where}"
     if last.phase == "hold":
         return 0, f"held at {where}"
     return 0, f"stopped while in phase {last.phase} at {where}"

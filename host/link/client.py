@@ -43,6 +43,9 @@ class RobotLink:
         self.hello: Any = None
         self.duplicates = 0  # resends the robot had already applied
         self.received_bytes = 0  # every byte read, frame or not (the handshake reports it)
+        self.resends = 0  # commands sent again after silence or a CRC NACK
+        self.nacks = 0  # NACKs received
+        self.resets = 0  # BOOTs (resets) the robot reported during the session
         self._ser: serial.Serial | None = None
         self._dec = FrameDecoder()
         self._seq = random.randrange(256)
@@ -82,6 +85,7 @@ class RobotLink:
             except ProtocolError:
                 continue  # a frame from a robot of another spec; the handshake says so
             if isinstance(msg, gen.Boot) and self.hello is not None:
+                self.resets += 1
                 raise LinkError(f"the robot reset during the session (cause "
                                 f"{gen.ResetCause(msg.reset_cause).name.lower()})")
             out.append(msg)
@@ -137,12 +141,14 @@ class RobotLink:
         """Send msg and wait for the reply match accepts; resend on silence or a CRC NACK."""
         seq = self._next_seq()
         frame = encode_frame(seq, *pack(msg))
-        for _ in range(self.retries):
+        for attempt in range(self.retries):
+            self.resends += attempt > 0
             self._write(frame)
             reply = self._await(lambda m: match(m, seq), self.reply_timeout_s)
             if reply is None:
                 continue
             if isinstance(reply, gen.Nack):
+                self.nacks += 1
                 if reply.error == gen.Error.BAD_CRC:
                     continue
                 raise LinkError(f"the robot refused {msg.NAME}: "

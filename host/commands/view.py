@@ -1,0 +1,87 @@
+"""host view: look at the camera pair live in the browser (left image, disparity, markers)
+without driving anything; and the --view option that host servo shares."""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import sys
+import time
+from collections.abc import Iterator
+
+from host.camera.calibration import Calibration, Geometry
+from host.camera.open import add_camera_options, open_source, parse_size
+from host.commands.options import add_matcher_options, params_from_args
+from host.errors import HostError
+from host.servo.marker import find_marker
+from host.servo.snapshot import Snapshot
+from host.stereo.matcher import compute_disparity
+
+
+def add_view_option(p: argparse.ArgumentParser, default: str | None = None) -> None:
+    p.add_argument("--view", nargs="?", const="127.0.0.1:0", default=default,
+                   metavar="[HOST:]PORT",
+                   help="serve a live view on this address (default 127.0.0.1 and a free port; "
+                        "another address than loopback needs the token printed at start)")
+
+
+@contextlib.contextmanager
+def open_view(address: str | None, servo=None) -> Iterator[object | None]:
+    """The live view on address ([HOST:]PORT), fed by servo's steps, its STOP button stopping
+    servo (no servo: no STOP); nothing when address is None. Prints the page's address."""
+    if address is None:
+        yield None
+        return
+    try:
+        from host.view import ViewFeed, ViewServer, parse_address
+    except ImportError as e:
+        raise HostError(f"--view needs the web stack: pip install 'stereo-servo[view]' "
+                        f"({e.name} is missing)") from None
+
+    host, port = parse_address(address)
+    feed = ViewFeed(can_stop=servo is not None)
+    try:
+        with ViewServer(feed, host, port, servo.request_stop if servo else None) as server:
+            if servo is not None:
+                servo.observers.append(feed)
+            note = "" if server.token is None else " (the token is needed: keep it private)"
+            print(f"live view: {server.url}{note}", file=sys.stderr, flush=True)
+            yield server
+    finally:
+        feed.close()
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("view", help="look at the stereo camera live in a browser (no robot)")
+    add_view_option(p, default="127.0.0.1:0")
+    p.add_argument("--duration", type=float, metavar="S", help="stop after S seconds")
+    add_camera_options(p)
+    add_matcher_options(p)
+    p.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    params = params_from_args(args)
+    with contextlib.ExitStack() as stack:
+        source = stack.enter_context(open_source(args))
+        geometry = (Calibration.load(args.calib).geometry if args.calib
+                    else Geometry.minoru_default(*parse_size(args.size)))
+        view = stack.enter_context(open_view(args.view))
+        t0 = time.monotonic()
+
+        def time_left() -> bool:
+            return args.duration is None or time.monotonic() - t0 < args.duration
+
+        last = None
+        for frame in source:
+            disp = compute_disparity(frame.left, frame.right, params)
+            last = find_marker(frame.left, frame.right, "disc", None, geometry.baseline_m, last)
+            view.feed(Snapshot(time.monotonic() - t0, "view", "no robot: looking only",
+                               frame.left, disp, 0, None, last, None, None, geometry))
+            if not time_left():
+                return 0
+        print("host view: the camera ended; the page shows its last frame (Ctrl-C to quit)",
+              file=sys.stderr, flush=True)
+        while time_left():
+            time.sleep(0.1)
+    return 0
