@@ -20,7 +20,7 @@ EXAMPLES = {
     "disparity": ["host disparity left.png right.png -o disp.png --num-disp 64 --npy disp.npy"],
     "tune": ["host tune --out tuned.toml --plot tuning.png",
              "host tune ../shared/data/middlebury --space sad --method qlearning --workers 2"],
-    "cameras": ["host cameras                  # the stereo cameras plugged in, with their --camera",
+    "cameras": ["host cameras           # the stereo cameras plugged in, with their --camera",
                 "host cameras --sysfs /tmp/fake-sys"],
     "capture": ["host capture --count 25 --interval 2 --out shots/"],
     "calibrate": ["host calibrate shots/ --board 9x6 --square 25 --out calib.yml",

@@ -22,9 +22,9 @@ from host.commands.options import (
     params_from_args,
 )
 from host.commands.servo_outcome import outcome
+from host.commands.view import add_view_option, open_view
 from host.errors import HostError, NotReached
 from host.files import check_output
-from host.commands.view import add_view_option, open_view
 from host.link.client import RobotLink
 from host.servo.controller import ControlConfig
 from host.servo.loop import Servo
