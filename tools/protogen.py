@@ -129,7 +129,8 @@ def load_spec(path: Path = SPEC) -> Spec:
         if msg.size > raw["protocol"]["max_payload"]:
             raise ValueError(f"message {msg.name}: payload {msg.size} > max_payload")
         messages.append(msg)
-    canonical = json.dumps(_strip_docs(raw), sort_keys=True, separators=(",", ":"))
+    wire = {k: v for k, v in raw.items() if k != "rule"}  # rules are prose, not wire facts
+    canonical = json.dumps(_strip_docs(wire), sort_keys=True, separators=(",", ":"))
     return Spec(raw, tuple(messages), zlib.crc32(canonical.encode()))
 
 
@@ -325,12 +326,9 @@ def render_docs(spec: Spec) -> str:
            f"  0x{p['start']:02X}   0..{p['max_payload']}", "```", "",
            f"- START is 0x{p['start']:02X}. LEN is the payload size; a LEN above {p['max_payload']}"
            " is rejected as soon as it is read (a framing error).",
-           "- SEQ numbers the host's commands (any value; the host counts up). The robot answers"
-           " every command with ACK or NACK carrying its SEQ, except HELLO (HELLO_REPLY) and"
-           " GET_STATUS (STATUS). A command with the same SEQ and ID as the last one applied is"
-           " acknowledged again (ACK result DUPLICATE) and not applied twice, so the host may"
-           " resend freely; HELLO starts a new session and a link-loss stop ends the old"
-           " stream, so after either the next command is applied whatever its SEQ.",
+           "- SEQ numbers the host's frames; the robot answers every command with ACK or NACK"
+           " carrying its SEQ, except HELLO (HELLO_REPLY) and GET_STATUS (STATUS). See"
+           " \"Sequence numbers and resends\" below.",
            f"- CRC is {p['crc']} (poly 0x1021, init 0xFFFF, no reflection, no final XOR) over LEN,"
            " SEQ, ID and PAYLOAD, sent low byte first. On the AVR: `_crc_xmodem_update` from"
            " `<util/crc16.h>` starting at 0xFFFF; on the host: crcmod's `crc-ccitt-false`.",
@@ -356,6 +354,9 @@ def render_docs(spec: Spec) -> str:
                 out.append(f"| {off} | {f.name} | {f.type} | {rng} | {f.unit} | {f.doc}{kind} |")
                 off += f.size
             out.append("")
+    out += ["## Rules of the link", ""]
+    for rule in spec.raw.get("rule", []):
+        out += [f"### {rule['name']}", "", rule["doc"], ""]
     out += ["## Enumerations", ""]
     for name, enum in spec.raw.get("enum", {}).items():
         out += [f"### {name}", "", enum["doc"], "", "| value | name | meaning |", "|---|---|---|"]

@@ -56,6 +56,7 @@ class FirmwareCore:
         self._lib.robot_init.argtypes = [ctypes.c_uint8, ctypes.c_uint32]
         self._lib.robot_rx_byte.argtypes = [ctypes.c_uint8, ctypes.c_uint32]
         self._lib.robot_tick.argtypes = [ctypes.c_uint32]
+        self._lib.robot_guard.argtypes = [ctypes.c_uint32]
         self._lib.emu_take_tx.argtypes = [ctypes.c_char_p, ctypes.c_uint16]
         self._lib.emu_take_tx.restype = ctypes.c_uint16
         self._lib.emu_motors.argtypes = [ctypes.POINTER(ctypes.c_int16)] * 2
@@ -68,6 +69,9 @@ class FirmwareCore:
             self._lib.robot_rx_byte(b, now_ms & 0xFFFFFFFF)
 
     def tick(self, now_ms: int) -> None:
+        """One millisecond tick: the link-loss guard (the AVR's timer interrupt), then the main
+        loop's periodic work."""
+        self._lib.robot_guard(now_ms & 0xFFFFFFFF)
         self._lib.robot_tick(now_ms & 0xFFFFFFFF)
 
     def take_tx(self) -> bytes:

@@ -1,9 +1,12 @@
-/* Timer0 in CTC mode interrupts at 1 kHz: F_CPU / 64 / (OCR0A + 1) = 16 MHz / 64 / 250. */
+/* Timer0 in CTC mode interrupts at 1 kHz: F_CPU / 64 / (OCR0A + 1) = 16 MHz / 64 / 250. Each tick
+ * also runs the core's link-loss guard, so the motor cut never waits for the main loop. */
 #include "clock.h"
 
 #include <avr/interrupt.h>
 #include <avr/io.h>
 #include <util/atomic.h>
+
+#include "../core/robot.h"
 
 static volatile uint32_t ms;
 
@@ -17,7 +20,9 @@ void clock_init(void)
 
 ISR(TIMER0_COMPA_vect)
 {
-    ms++;
+    uint32_t now = ms + 1;
+    ms = now;
+    robot_guard(now);
 }
 
 uint32_t clock_ms(void)

@@ -2,6 +2,7 @@
 #include "motors.h"
 
 #include <avr/io.h>
+#include <util/atomic.h>
 
 #include "../config.h"
 #include "../core/board.h"
@@ -42,8 +43,14 @@ void board_motor_output(int16_t left, int16_t right)
     uint8_t dir = direction(left, MOTOR_LEFT_IN1_BIT, MOTOR_LEFT_IN2_BIT) |
                   direction(right, MOTOR_RIGHT_IN3_BIT, MOTOR_RIGHT_IN4_BIT);
     uint16_t a = compare(left), b = compare(right);
-    /* the three writes follow each other within a few cycles */
-    MOTOR_DIR_PORT = (uint8_t)((MOTOR_DIR_PORT & ~mask) | dir);
-    OCR1A = a;
-    OCR1B = b;
+    /* Called from the main loop and from the timer interrupt (the link-loss cut): the 16-bit
+     * OCR writes share the timer's TEMP register, so no interrupt may come between them. The
+     * core only changes direction through zero and a coast interval, so the direction pins
+     * never change while a bridge is driven. */
+    ATOMIC_BLOCK(ATOMIC_RESTORESTATE)
+    {
+        MOTOR_DIR_PORT = (uint8_t)((MOTOR_DIR_PORT & ~mask) | dir);
+        OCR1A = a;
+        OCR1B = b;
+    }
 }
