@@ -11,7 +11,7 @@ import subprocess
 import tempfile
 from pathlib import Path
 
-from host.emulator.build import FIRMWARE, ROOT
+from host.emulator.build import FIRMWARE, ROOT, BuildFailed, ToolMissing
 from host.errors import HostError
 
 SOURCES = [FIRMWARE / "core" / "robot.c", FIRMWARE / "core" / "drive.c",
@@ -28,7 +28,7 @@ def build_library() -> Path:
     if missing:
         raise HostError(f"firmware sources not found ({missing[0]}): run from a source checkout")
     if shutil.which("gcc") is None:
-        raise HostError("gcc not found: the emulator compiles the firmware core natively")
+        raise ToolMissing("gcc not found: the emulator compiles the firmware core natively")
     digest = hashlib.sha256(b"".join(p.read_bytes() for p in SOURCES + HEADERS)).hexdigest()[:16]
     lib = CACHE / f"firmware-core-{digest}.so"
     if lib.exists():
@@ -39,7 +39,7 @@ def build_library() -> Path:
            f"-I{ROOT / 'protocol' / 'c'}", *map(str, SOURCES), "-o", str(tmp)]
     r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode:
-        raise HostError(f"building the firmware core failed: {r.stderr.strip()[:300]}")
+        raise BuildFailed(f"building the firmware core failed: {r.stderr.strip()[:300]}")
     os.replace(tmp, lib)
     return lib
 
