@@ -47,19 +47,6 @@ def test_set_drive_sets_compare_registers_and_direction_pins(harness, firmware_e
     assert messages(r)[-1] == gen.Ack(seq=1, result=gen.AckResult.APPLIED)
 
 
-def test_link_loss_stops_the_motors_at_the_timeout(harness, firmware_elf) -> None:
-    r = run(harness, firmware_elf, Script().run_ms(5)
-            .message(1, gen.SetDrive(left=400, right=400)).run_ms(400)
-            .message(2, gen.GetStatus()).run_ms(10))
-    on, off = r.settled()[-2:]
-    assert on.ocr1a == 160 and (off.ocr1a, off.ocr1b, off.dir) == (0, 0, 0)
-    stop_ms = (off.cycle - (r.ins[9][0] + CYCLES_PER_BYTE)) / MS
-    assert gen.DEFAULT_LINK_TIMEOUT_MS <= stop_ms < gen.DEFAULT_LINK_TIMEOUT_MS + 2, stop_ms
-    status = messages(r)[-1]
-    assert status.flags & gen.StatusFlag.LINK_LOST and not status.flags & gen.StatusFlag.DRIVING
-    assert (status.left, status.right) == (0, 0)
-
-
 def test_set_config_changes_the_link_timeout(harness, firmware_elf) -> None:
     r = run(harness, firmware_elf, Script().run_ms(2)
             .message(1, gen.SetConfig(link_timeout_ms=100, accel_limit=0)).run_ms(5)

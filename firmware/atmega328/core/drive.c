@@ -58,11 +58,13 @@ uint8_t drive_tick(struct drive *d, uint16_t elapsed_ms)
     }
     uint8_t changed = 0;
     for (uint8_t m = DRIVE_LEFT; m <= DRIVE_RIGHT; m++) {
-        if (d->applied[m] == 0)
-            d->coast_ms[m] = d->coast_ms[m] > elapsed_ms ? d->coast_ms[m] - elapsed_ms : 0;
         int16_t next = approach(d->applied[m], goal(d, m), step);
+        /* counted down after the move: zero was reached somewhere within the last tick, so the
+         * motor leaves it only once more than the coast interval has surely passed */
         if (d->applied[m] && !next)
             d->coast_ms[m] = PROTO_DEFAULT_REVERSE_COAST_MS;
+        else if (!next)
+            d->coast_ms[m] = d->coast_ms[m] > elapsed_ms ? d->coast_ms[m] - elapsed_ms : 0;
         changed |= next != d->applied[m];
         d->applied[m] = next;
     }

@@ -109,7 +109,10 @@ static void feed_uart(void)
     h.n_in++;
     if (h.pty_fd < 0 && !h.quiet)
         printf("in %llu %02x\n", (unsigned long long)h.avr->cycle, byte);
-    h.next_in = h.avr->cycle + CYCLES_PER_BYTE;
+    /* the next byte one byte time after this one's slot (not after now: a sleeping CPU lets
+     * the cycle count jump, and the line does not wait for it) unless the line was idle */
+    avr_cycle_count_t slot = h.avr->cycle - h.next_in < CYCLES_PER_BYTE ? h.next_in : h.avr->cycle;
+    h.next_in = slot + CYCLES_PER_BYTE;
     avr_raise_irq(h.uart_in, byte);
 }
 
