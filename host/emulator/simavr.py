@@ -4,6 +4,7 @@ cycles."""
 
 from __future__ import annotations
 
+import random
 import subprocess
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -55,6 +56,34 @@ class SimRun:
     def last_in_done(self) -> int:
         """Cycle at which the last byte sent had fully arrived (its stop bit)."""
         return self.ins[-1][0] + CYCLES_PER_BYTE
+
+
+FLOODS = ("bad-crc", "get-status", "refused", "garbage")
+
+
+def flood(kind: str, n_bytes: int, seed: int = 11) -> bytes:
+    """At least n_bytes of hostile traffic: SET_DRIVE frames with a bad CRC, valid GET_STATUS
+    polls, refused frames (good CRC, duty out of range) or random garbage."""
+    if kind == "garbage":
+        rng = random.Random(seed)
+        return bytes(rng.randrange(256) for _ in range(n_bytes))
+    frames: list[bytes] = []
+    size = 0
+    while size < n_bytes:
+        i = len(frames) & 0xFF
+        if kind == "bad-crc":
+            f = bytearray(encode_frame(i, *pack(gen.SetDrive(left=700, right=700))))
+            f[-1] ^= 0x5A
+        elif kind == "get-status":
+            f = bytearray(encode_frame(i, *pack(gen.GetStatus())))
+        elif kind == "refused":
+            f = bytearray(encode_frame(i, gen.SetDrive.ID,
+                                       (1500).to_bytes(2, "little", signed=True) + bytes(2)))
+        else:
+            raise ValueError(f"unknown flood {kind!r}")
+        frames.append(bytes(f))
+        size += len(f)
+    return b"".join(frames)
 
 
 class Script:

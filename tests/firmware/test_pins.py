@@ -6,15 +6,12 @@ under floods at line rate without flow control, overruns, and the duplicate coun
 
 from __future__ import annotations
 
-import random
-
 import pytest
 
 from host.emulator.pins import Pin, enable_pin, timeline
-from host.emulator.simavr import CYCLES_PER_BYTE, F_CPU, Script, run
+from host.emulator.simavr import CYCLES_PER_BYTE, F_CPU, FLOODS, Script, flood, run
 from host.link import protocol_gen as gen
-from host.link.frame import encode_frame
-from host.link.messages import pack, unpack
+from host.link.messages import unpack
 
 MS = F_CPU // 1000
 NO_RAMP = gen.SetConfig(link_timeout_ms=gen.DEFAULT_LINK_TIMEOUT_MS, accel_limit=0)
@@ -108,26 +105,7 @@ def test_the_default_ramp_takes_duty_up_at_the_acceleration_limit(harness, firmw
     assert max(steps) <= 2 * gen.DEFAULT_ACCEL_LIMIT / 100 / 1000 + 1e-9
 
 
-def flood(kind: str, n_bytes: int) -> bytes:
-    rng = random.Random(11)
-    if kind == "garbage":
-        return bytes(rng.randrange(256) for _ in range(n_bytes))
-    frames = []
-    while sum(map(len, frames)) < n_bytes:
-        i = len(frames)
-        if kind == "bad-crc":
-            f = bytearray(encode_frame(i & 0xFF, *pack(gen.SetDrive(left=700, right=700))))
-            f[-1] ^= 0x5A
-        elif kind == "get-status":
-            f = encode_frame(i & 0xFF, *pack(gen.GetStatus()))
-        else:  # refused: a good CRC, a duty out of range
-            f = encode_frame(i & 0xFF, gen.SetDrive.ID, (1500).to_bytes(2, "little", signed=True)
-                             + bytes(2))
-        frames.append(bytes(f))
-    return b"".join(frames)
-
-
-@pytest.mark.parametrize("kind", ["quiet", "bad-crc", "get-status", "refused", "garbage"])
+@pytest.mark.parametrize("kind", ["quiet", *FLOODS])
 def test_the_motors_stop_250_ms_after_the_last_accepted_drive_whatever_follows(
         harness, firmware_elf, kind):
     s = Script().run_ms(2).message(0, NO_RAMP).run_ms(2)
@@ -149,6 +127,13 @@ def test_the_motors_stop_250_ms_after_the_last_accepted_drive_whatever_follows(
     assert not status.flags & gen.StatusFlag.DRIVING and (status.left, status.right) == (0, 0)
     if kind != "quiet":  # faster than simavr's UART takes bytes: it overran, and it was counted
         assert status.rx_overruns > 0
+    if kind == "get-status":  # 30-byte answers to 6-byte polls: dropped, never waited for
+        assert status.tx_dropped > 0
+    nacks = sum(m.NAME == "NACK" for m in messages(r))
+    flood_ms = 520  # NACKs are rate-limited: a burst, then one per interval
+    assert nacks <= 4 + flood_ms / gen.DEFAULT_NACK_INTERVAL_MS + 1, nacks
+    if kind in ("bad-crc", "refused"):
+        assert nacks >= flood_ms / gen.DEFAULT_NACK_INTERVAL_MS / 2  # but they still come
 
 
 def test_bytes_that_pile_up_while_the_main_loop_stalls_are_counted_as_overruns(

@@ -62,7 +62,7 @@ static const struct {
 static struct {
     avr_t *avr;
     avr_irq_t *uart_in;
-    int xon, flow;
+    int xon, flow, feeding;
     uint8_t *queue; /* bytes waiting for UART0: queue[q_head..q_tail) */
     size_t q_head, q_tail, q_cap;
     avr_cycle_count_t next_in;
@@ -101,19 +101,33 @@ static void no_sleep(avr_t *avr, avr_cycle_count_t how_long)
     (void)avr, (void)how_long; /* scripted mode runs as fast as it can */
 }
 
-static void feed_uart(void)
+/* Cycle timer: one byte into UART0 per byte time while the queue has bytes. A timer, not a
+ * check between instructions, so a byte arrives on time also while the CPU sleeps. */
+static avr_cycle_count_t inject(struct avr_t *avr, avr_cycle_count_t when, void *param)
 {
-    if (h.q_head == h.q_tail || (h.flow && !h.xon) || h.avr->cycle < h.next_in)
-        return;
+    (void)param;
+    if (h.q_head == h.q_tail) {
+        h.feeding = 0;
+        return 0;
+    }
+    if (h.flow && !h.xon)
+        return when + CYCLES_PER_BYTE / 16; /* the UART is full: look again shortly */
     uint8_t byte = h.queue[h.q_head++];
     h.n_in++;
     if (h.pty_fd < 0 && !h.quiet)
-        printf("in %llu %02x\n", (unsigned long long)h.avr->cycle, byte);
-    /* the next byte one byte time after this one's slot (not after now: a sleeping CPU lets
-     * the cycle count jump, and the line does not wait for it) unless the line was idle */
-    avr_cycle_count_t slot = h.avr->cycle - h.next_in < CYCLES_PER_BYTE ? h.next_in : h.avr->cycle;
-    h.next_in = slot + CYCLES_PER_BYTE;
+        printf("in %llu %02x\n", (unsigned long long)avr->cycle, byte);
     avr_raise_irq(h.uart_in, byte);
+    h.next_in = when + CYCLES_PER_BYTE;
+    return h.next_in;
+}
+
+static void start_feeding(void)
+{
+    if (h.feeding || h.q_head == h.q_tail)
+        return;
+    h.feeding = 1;
+    avr_cycle_count_t now = h.avr->cycle;
+    avr_cycle_timer_register(h.avr, h.next_in > now ? h.next_in - now : 1, inject, NULL);
 }
 
 static void watch_io(void)
@@ -145,15 +159,24 @@ static int step(void)
     if (h.avr->pc == 0 && pc != 0) {
         h.resets++;
         h.xon = 0; /* hold bytes until the reset firmware enables its UART again */
+        h.feeding = 0; /* the reset dropped the cycle timers */
+        start_feeding();
         fprintf(h.events, "reset %llu\n", (unsigned long long)h.avr->cycle);
     }
-    feed_uart();
     watch_io();
     return 0;
 }
 
+static avr_cycle_count_t wake(struct avr_t *avr, avr_cycle_count_t when, void *param)
+{
+    (void)avr, (void)when, (void)param;
+    return 0; /* nothing to do: the timer only ends a sleep at the end of a run */
+}
+
 static int run_until(avr_cycle_count_t end)
 {
+    if (end > h.avr->cycle) /* a sleeping CPU would otherwise run on to its next interrupt */
+        avr_cycle_timer_register(h.avr, end - h.avr->cycle, wake, NULL);
     while (h.avr->cycle < end)
         if (step() < 0)
             return -1;
@@ -173,6 +196,7 @@ static void queue_byte(uint8_t byte)
         }
     }
     h.queue[h.q_tail++] = byte;
+    start_feeding();
 }
 
 static void queue_hex(const char *hex)
