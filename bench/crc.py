@@ -1,5 +1,5 @@
 """Which CRC for the link: corrupted frames that each CRC lets through, measured on the
-protocol's own frame lengths (SET_DRIVE 10 bytes, STATUS 30 bytes) with numba.
+protocol's own frame lengths (SET_DRIVE and STATUS) with numba.
 
 Corruption models, each applied to 10^7 copies of a valid frame (seeded, reproducible):
   bytes  2..6 distinct bytes of SEQ ID PAYLOAD CRC replaced by other random values

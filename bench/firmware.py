@@ -21,6 +21,7 @@ from host.link.messages import pack, unpack
 
 MS = F_CPU // 1000
 NO_RAMP = gen.SetConfig(link_timeout_ms=gen.DEFAULT_LINK_TIMEOUT_MS, accel_limit=0)
+FRAME = len(encode_frame(0, *pack(NO_RAMP)))  # bytes of a SET_CONFIG or SET_DRIVE frame
 
 
 def driving(d) -> bool:
@@ -47,7 +48,7 @@ def stop_times(harness: Path, elf: Path) -> None:
                 s.flow(False).send(flood(kind, 500 * MS // CYCLES_PER_BYTE, seed=i))
             s.run_ms(520).flow(True).quiet(False).message(2, gen.GetStatus()).run_ms(10)
             r = run(harness, elf, s)
-            done = r.ins[19][0] + CYCLES_PER_BYTE
+            done = r.ins[2 * FRAME - 1][0] + CYCLES_PER_BYTE
             t = [d for d in timeline(r.io, "left") if d.cycle > done]
             on = next(k for k, d in enumerate(t) if driving(d))
             off = next(d for d in t[on:] if not driving(d))

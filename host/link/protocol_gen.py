@@ -7,14 +7,14 @@ import enum
 from dataclasses import dataclass
 from typing import ClassVar
 
-SCHEMA_HASH = 0x7B2D1EE9
+SCHEMA_HASH = 0xF490713D
 VERSION = 1
 BAUD = 115200
 START = 0xA5
 MAX_PAYLOAD = 24
 HEADER_LEN = 4  # START LEN SEQ ID
-CRC_LEN = 2
-CRC_NAME = "crc-ccitt-false"
+CRC_LEN = 4
+CRC_NAME = "crc-32c"
 DEFAULT_LINK_TIMEOUT_MS = 250
 DEFAULT_ACCEL_LIMIT = 400
 DEFAULT_REVERSE_COAST_MS = 10

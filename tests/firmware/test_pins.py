@@ -11,10 +11,12 @@ import pytest
 from host.emulator.pins import Pin, enable_pin, timeline
 from host.emulator.simavr import CYCLES_PER_BYTE, F_CPU, FLOODS, Script, flood, run
 from host.link import protocol_gen as gen
-from host.link.messages import unpack
+from host.link.frame import encode_frame
+from host.link.messages import pack, unpack
 
 MS = F_CPU // 1000
 NO_RAMP = gen.SetConfig(link_timeout_ms=gen.DEFAULT_LINK_TIMEOUT_MS, accel_limit=0)
+FRAME = len(encode_frame(0, *pack(NO_RAMP)))  # bytes of a SET_CONFIG or SET_DRIVE frame
 
 
 def messages(r):
@@ -114,7 +116,7 @@ def test_the_motors_stop_250_ms_after_the_last_accepted_drive_whatever_follows(
         s.flow(False).send(flood(kind, 500 * MS // CYCLES_PER_BYTE))  # 500 ms at line rate
     s.run_ms(520).flow(True).quiet(False).message(2, gen.GetStatus()).run_ms(10)
     r = run(harness, firmware_elf, s)
-    drive_done = r.ins[19][0] + CYCLES_PER_BYTE  # the SET_DRIVE's stop bit
+    drive_done = r.ins[2 * FRAME - 1][0] + CYCLES_PER_BYTE  # the SET_DRIVE's stop bit
     t = [d for d in timeline(r.io, "left") if d.cycle > drive_done]
     on = next(i for i, d in enumerate(t) if driving(d))
     off = next(d for d in t[on:] if not driving(d))

@@ -10,7 +10,8 @@ import pytest
 
 from host.emulator.simavr import CYCLES_PER_BYTE, F_CPU, Script, run
 from host.link import protocol_gen as gen
-from host.link.messages import describe, unpack
+from host.link.frame import encode_frame
+from host.link.messages import describe, pack, unpack
 
 MS = F_CPU // 1000
 ROOT = Path(__file__).resolve().parents[2]
@@ -59,9 +60,6 @@ def test_set_config_changes_the_link_timeout(harness, firmware_elf) -> None:
 
 def test_garbage_and_corrupted_frames_are_refused_and_the_next_frame_works(
         harness, firmware_elf) -> None:
-    from host.link.frame import encode_frame
-    from host.link.messages import pack
-
     bad = bytearray(encode_frame(3, *pack(gen.SetDrive(left=900, right=900))))
     bad[5] ^= 0x40
     script = (Script().run_ms(2).message(0, NO_RAMP).run_ms(2)
@@ -92,7 +90,7 @@ def test_watchdog_resets_a_hung_firmware_with_the_motors_off(harness, hang_elf) 
          .message(3, gen.Hello(nonce=1)).run_ms(5).message(4, gen.GetStatus()).run_ms(5))
     r = run(harness, hang_elf, s)
     assert len(r.resets) == 1
-    hang_start = r.ins[29][0] + CYCLES_PER_BYTE
+    hang_start = r.ins[3 * len(encode_frame(0, *pack(NO_RAMP))) - 1][0] + CYCLES_PER_BYTE
     # WDTO_120MS is nominal; simavr times it at about 99 ms, the datasheet allows 0.8x-1.2x
     assert 80 <= (r.resets[0] - hang_start) / MS <= 150
     driving = [p for p in r.settled() if p.cycle < r.resets[0]][-1]
@@ -108,11 +106,8 @@ def test_watchdog_resets_a_hung_firmware_with_the_motors_off(harness, hang_elf) 
 
 
 def test_ten_seconds_of_line_rate_traffic_cause_no_watchdog_reset(harness, firmware_elf) -> None:
-    from host.link.frame import encode_frame
-    from host.link.messages import pack
-
-    # simavr's UART takes a byte per 1496 cycles (10.7 kB/s): 10-byte frames for over 10 s
-    n = 10800
+    # simavr's UART takes a byte per 1496 cycles (10.7 kB/s): 12-byte frames for over 10 s
+    n = 9000
     data = b"".join(encode_frame(i & 0xFF, *pack(gen.SetDrive(left=i % 1000, right=-(i % 1000))))
                     for i in range(n))
     r = run(harness, firmware_elf, Script().quiet().run_ms(1).send(data).run_ms(10_200))

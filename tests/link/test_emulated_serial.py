@@ -16,7 +16,8 @@ from host.link.client import LinkError, RobotLink
 
 def test_every_command_gets_through_a_line_with_five_percent_corrupted_bytes() -> None:
     emu = Emulator(Faults(corrupt=0.05, seed=4))
-    with PtyService(emu) as service, RobotLink(service.path, retries=30,
+    # one byte in 20 corrupted: HELLO and its 25-byte reply both get through one try in six
+    with PtyService(emu) as service, RobotLink(service.path, retries=30, handshake_s=10,
                                                reply_timeout_s=0.02) as robot:
         robot.set_config(link_timeout_ms=250, accel_limit=0)  # no ramp: this tests the link
         for i in range(80):
