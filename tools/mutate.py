@@ -25,8 +25,9 @@ ROOT = Path(__file__).resolve().parents[1]
 MUTANTS = ROOT / "firmware" / "atmega328" / "mutants.toml"
 TESTS = ["tests/firmware", "tests/link", "tests/protocol"]
 TIMEOUT_S = 900
-# tests of the build set-up (a git checkout, a compiler error), not of the firmware's behaviour
-BUILD_SYSTEM_TESTS = ["tests/firmware/test_build_errors.py"]
+# tests of the set-up (a git checkout, a compiler error, the mutants file itself, which a
+# mutant's own edit makes stale), not of the firmware's behaviour
+BUILD_SYSTEM_TESTS = ["tests/firmware/test_build_errors.py", "tests/firmware/test_mutants_file.py"]
 
 
 @dataclass
