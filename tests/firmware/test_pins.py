@@ -75,8 +75,7 @@ def reversal(r, motor: str = "left") -> tuple[float, list]:
     fwd_end = max(i for i, d in enumerate(t) if driving(d) and d.direction == "forward")
     rev_start = min(i for i, d in enumerate(t) if driving(d) and d.direction == "reverse")
     assert fwd_end < rev_start
-    return (t[fwd_end + 1].cycle and (t[rev_start].cycle - t[fwd_end + 1].cycle) / MS,
-            t[fwd_end + 1:rev_start])
+    return (t[rev_start].cycle - t[fwd_end + 1].cycle) / MS, t[fwd_end + 1:rev_start]
 
 
 @pytest.mark.parametrize("ramp", [False, True], ids=["no-ramp", "default-ramp"])
