@@ -98,8 +98,8 @@ static void on_set_drive(const struct frame *f)
     if (m.left == 999 && m.right == -999)
         for (;;) /* test build only: a hang the watchdog must catch */
             ;
-    if (m.left == 998 && m.right == -998) /* test build only: a stall of some 40 ms */
-        for (volatile uint32_t i = 0; i < 30000UL; i++) /* so that received bytes pile up */
+    if (m.left == 998 && m.right == -998) /* test build only: a stall in the main loop, */
+        for (volatile uint32_t i = 0; i < 30000UL; i++) /* long enough to fill the RX ring */
             ;
 #endif
     uint8_t state = board_lock();
