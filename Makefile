@@ -10,7 +10,7 @@ DATA ?= $(abspath ../shared/data)
 # tests and benchmarks find the Middlebury scenes through this variable
 export STEREO_SERVO_DATA ?= $(if $(wildcard $(DATA)/middlebury/index.json),$(DATA),)
 
-.PHONY: demo test lint bench venv system-deps browser-deps protocol firmware flash clean
+.PHONY: demo test lint bench venv system-deps browser-deps protocol firmware flash mutants clean
 
 $(BIN)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -44,9 +44,16 @@ bench: venv
 	$(BIN)/python bench/matcher.py
 	$(BIN)/python bench/tuning.py
 	$(BIN)/python bench/protocol.py
+	$(BIN)/python bench/crc.py
 	$(BIN)/python bench/firmware.py
 	$(BIN)/python bench/link.py
 	$(BIN)/python bench/servo.py
+	$(MAKE) mutants
+
+# firmware mutation testing (firmware/atmega328/mutants.toml): every mutant must be killed; it
+# takes several minutes, so it runs with the benchmarks, not in make test
+mutants: venv system-deps
+	$(BIN)/python tools/mutate.py
 
 # regenerate everything derived from protocol/spec.toml (tests fail while it is stale)
 protocol: venv

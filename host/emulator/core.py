@@ -11,7 +11,7 @@ import subprocess
 import tempfile
 from pathlib import Path
 
-from host.emulator.build import FIRMWARE, ROOT
+from host.emulator.build import FIRMWARE, ROOT, BuildFailed, ToolMissing
 from host.errors import HostError
 
 SOURCES = [FIRMWARE / "core" / "robot.c", FIRMWARE / "core" / "drive.c",
@@ -28,7 +28,7 @@ def build_library() -> Path:
     if missing:
         raise HostError(f"firmware sources not found ({missing[0]}): run from a source checkout")
     if shutil.which("gcc") is None:
-        raise HostError("gcc not found: the emulator compiles the firmware core natively")
+        raise ToolMissing("gcc not found: the emulator compiles the firmware core natively")
     digest = hashlib.sha256(b"".join(p.read_bytes() for p in SOURCES + HEADERS)).hexdigest()[:16]
     lib = CACHE / f"firmware-core-{digest}.so"
     if lib.exists():
@@ -39,7 +39,7 @@ def build_library() -> Path:
            f"-I{ROOT / 'protocol' / 'c'}", *map(str, SOURCES), "-o", str(tmp)]
     r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode:
-        raise HostError(f"building the firmware core failed: {r.stderr.strip()[:300]}")
+        raise BuildFailed(f"building the firmware core failed: {r.stderr.strip()[:300]}")
     os.replace(tmp, lib)
     return lib
 
@@ -56,6 +56,7 @@ class FirmwareCore:
         self._lib.robot_init.argtypes = [ctypes.c_uint8, ctypes.c_uint32]
         self._lib.robot_rx_byte.argtypes = [ctypes.c_uint8, ctypes.c_uint32]
         self._lib.robot_tick.argtypes = [ctypes.c_uint32]
+        self._lib.robot_guard.argtypes = [ctypes.c_uint32]
         self._lib.emu_take_tx.argtypes = [ctypes.c_char_p, ctypes.c_uint16]
         self._lib.emu_take_tx.restype = ctypes.c_uint16
         self._lib.emu_motors.argtypes = [ctypes.POINTER(ctypes.c_int16)] * 2
@@ -68,6 +69,9 @@ class FirmwareCore:
             self._lib.robot_rx_byte(b, now_ms & 0xFFFFFFFF)
 
     def tick(self, now_ms: int) -> None:
+        """One millisecond tick: the link-loss guard (the AVR's timer interrupt), then the main
+        loop's periodic work."""
+        self._lib.robot_guard(now_ms & 0xFFFFFFFF)
         self._lib.robot_tick(now_ms & 0xFFFFFFFF)
 
     def take_tx(self) -> bytes:

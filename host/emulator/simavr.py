@@ -1,12 +1,15 @@
 """Run the real firmware ELF under simavr (firmware/atmega328/simavr/harness.c) from a script,
-and read back what its pins and UART did, in simulated CPU cycles."""
+and read back what its registers, pins (host/emulator/pins.py) and UART did, in simulated CPU
+cycles."""
 
 from __future__ import annotations
 
+import random
 import subprocess
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from host.emulator.pins import Io
 from host.link import protocol_gen as gen
 from host.link.frame import Frame, FrameDecoder, encode_frame
 from host.link.messages import pack
@@ -17,17 +20,21 @@ CYCLES_PER_BYTE = 10 * F_CPU // gen.BAUD  # the harness feeds bytes at the host'
 
 @dataclass
 class Pwm:
+    """The motor registers after a change: compare values and PD4..PD7 (IN1 IN2 IN3 IN4 as
+    bits 0..3)."""
+
     cycle: int
     ocr1a: int
     ocr1b: int
-    dir: int  # PD4..PD7 = IN1 IN2 IN3 IN4 as bits 0..3
+    dir: int
 
 
 @dataclass
 class SimRun:
     ins: list[tuple[int, int]] = field(default_factory=list)   # (cycle, byte) into the UART
     tx: list[tuple[int, int]] = field(default_factory=list)    # (cycle, byte) out of the UART
-    pwm: list[Pwm] = field(default_factory=list)
+    io: list[Io] = field(default_factory=list)                 # register states, by change
+    pwm: list[Pwm] = field(default_factory=list)               # motor registers, by change
     resets: list[int] = field(default_factory=list)
     end_cycle: int = 0
     seconds: float = 0.0
@@ -51,6 +58,34 @@ class SimRun:
         return self.ins[-1][0] + CYCLES_PER_BYTE
 
 
+FLOODS = ("bad-crc", "get-status", "refused", "garbage")
+
+
+def flood(kind: str, n_bytes: int, seed: int = 11) -> bytes:
+    """At least n_bytes of hostile traffic: SET_DRIVE frames with a bad CRC, valid GET_STATUS
+    polls, refused frames (good CRC, duty out of range) or random garbage."""
+    if kind == "garbage":
+        rng = random.Random(seed)
+        return bytes(rng.randrange(256) for _ in range(n_bytes))
+    frames: list[bytes] = []
+    size = 0
+    while size < n_bytes:
+        i = len(frames) & 0xFF
+        if kind == "bad-crc":
+            f = bytearray(encode_frame(i, *pack(gen.SetDrive(left=700, right=700))))
+            f[-1] ^= 0x5A
+        elif kind == "get-status":
+            f = bytearray(encode_frame(i, *pack(gen.GetStatus())))
+        elif kind == "refused":
+            f = bytearray(encode_frame(i, gen.SetDrive.ID,
+                                       (1500).to_bytes(2, "little", signed=True) + bytes(2)))
+        else:
+            raise ValueError(f"unknown flood {kind!r}")
+        frames.append(bytes(f))
+        size += len(f)
+    return b"".join(frames)
+
+
 class Script:
     """Commands for the harness: send bytes, let simulated time pass."""
 
@@ -66,6 +101,12 @@ class Script:
 
     def run_ms(self, ms: float) -> Script:
         self.lines.append(f"run {ms}")
+        return self
+
+    def flow(self, on: bool) -> Script:
+        """on: bytes go in only while simavr's UART can take them; off: at line rate regardless,
+        so that the receiver overruns when the firmware falls behind."""
+        self.lines.append(f"flow {int(on)}")
         return self
 
     def quiet(self, on: bool = True) -> Script:
@@ -88,8 +129,13 @@ def run(harness: Path, elf: Path, script: Script, timeout: float = 120) -> SimRu
             r.ins.append((int(rest[0]), int(rest[1], 16)))
         elif kind == "tx":
             r.tx.append((int(rest[0]), int(rest[1], 16)))
-        elif kind == "pwm":
-            r.pwm.append(Pwm(*map(int, rest)))
+        elif kind == "io":
+            io = Io(int(rest[0]), *(int(x, 16) for x in rest[1:]))
+            r.io.append(io)
+            p = Pwm(io.cycle, io.ocr1a, io.ocr1b, io.portd >> 4 & 0xF)
+            if not r.pwm or (r.pwm[-1].ocr1a, r.pwm[-1].ocr1b, r.pwm[-1].dir) != (
+                    p.ocr1a, p.ocr1b, p.dir):
+                r.pwm.append(p)
         elif kind == "reset":
             r.resets.append(int(rest[0]))
         elif kind == "end":

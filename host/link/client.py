@@ -2,7 +2,7 @@
 
     with RobotLink("/dev/ttyACM0") as robot:   # opens, says HELLO, checks the schema hash
         robot.drive(300, 300)                  # permille duty; resent until acknowledged
-        robot.keepalive()                      # call at least every keepalive_s while driving
+        robot.keepalive()                      # call often: resends the drive every keepalive_s
     # leaving the block sends STOP, also on an exception or Ctrl-C
 
 Every failure is a LinkError with a one-line message.
@@ -48,9 +48,13 @@ class RobotLink:
         self.resets = 0  # BOOTs (resets) the robot reported during the session
         self._ser: serial.Serial | None = None
         self._dec = FrameDecoder()
+        # commands and polls are numbered from separate counters (docs/protocol.md, "Sequence
+        # numbers and resends"), so polls can never bring a command's SEQ round again
         self._seq = random.randrange(256)
+        self._poll_seq = random.randrange(256)
+        self._last_command = b""  # the last command frame written, for judging DUPLICATE
         self._last_drive: tuple[int, int] | None = None
-        self._last_sent = 0.0
+        self._last_drive_sent = 0.0
 
     # ----------------------------------------------------------------------------- port I/O
 
@@ -69,7 +73,6 @@ class RobotLink:
             self._ser.write(data)
         except (serial.SerialException, OSError) as e:
             raise LinkError(f"lost the serial port {self.port}: {_reason(e)}") from None
-        self._last_sent = time.monotonic()
 
     def _messages(self) -> list[Any]:
         assert self._ser is not None
@@ -117,7 +120,7 @@ class RobotLink:
             return isinstance(m, gen.HelloReply) and m.nonce == nonce
 
         while time.monotonic() < deadline:
-            self._write(encode_frame(self._next_seq(), *pack(gen.Hello(nonce=nonce))))
+            self._write(encode_frame(self._next_poll_seq(), *pack(gen.Hello(nonce=nonce))))
             reply = self._await(is_reply, min(0.25, max(0.0, deadline - time.monotonic())))
             if reply is None:
                 continue
@@ -137,13 +140,20 @@ class RobotLink:
         self._seq = (self._seq + 1) & 0xFF
         return self._seq
 
-    def _transact(self, msg: Any, match: Callable[[Any, int], bool]) -> Any:
-        """Send msg and wait for the reply match accepts; resend on silence or a CRC NACK."""
-        seq = self._next_seq()
+    def _next_poll_seq(self) -> int:
+        self._poll_seq = (self._poll_seq + 1) & 0xFF
+        return self._poll_seq
+
+    def _transact(self, msg: Any, match: Callable[[Any, int], bool], seq: int) -> Any:
+        """Send msg as seq and wait for the reply match accepts; resend on silence or a CRC
+        NACK."""
         frame = encode_frame(seq, *pack(msg))
+        sent_before = frame == self._last_command
         for attempt in range(self.retries):
             self.resends += attempt > 0
             self._write(frame)
+            if msg.ID != gen.GetStatus.ID:
+                self._last_command = frame
             reply = self._await(lambda m: match(m, seq), self.reply_timeout_s)
             if reply is None:
                 continue
@@ -153,6 +163,12 @@ class RobotLink:
                     continue
                 raise LinkError(f"the robot refused {msg.NAME}: "
                                 f"{gen.Error(reply.error).name.lower().replace('_', ' ')}")
+            if (isinstance(reply, gen.Ack) and reply.result == gen.AckResult.DUPLICATE
+                    and not (attempt or sent_before)):
+                # the robot took a frame it had never been sent for a resend: the command
+                # was not applied, and it is still doing something else
+                raise LinkError(f"the robot answered {msg.NAME} (seq {seq}) as a duplicate of "
+                                f"another command: it was not applied")
             return reply
         raise LinkError(f"the robot did not answer {msg.NAME} after {self.retries} tries "
                         f"({self.reply_timeout_s * 1000:.0f} ms each)")
@@ -160,7 +176,7 @@ class RobotLink:
     def command(self, msg: Any) -> Any:
         """Send a command and return its ACK."""
         ack = self._transact(msg, lambda m, seq: isinstance(m, (gen.Ack, gen.Nack))
-                             and m.seq == seq)
+                             and m.seq == seq, self._next_seq())
         if ack.result == gen.AckResult.DUPLICATE:
             self.duplicates += 1
         return ack
@@ -169,24 +185,27 @@ class RobotLink:
         """Set both motors' duty in permille (-1000..1000, positive = forward)."""
         self.command(gen.SetDrive(left=int(left), right=int(right)))
         self._last_drive = (int(left), int(right))
+        self._last_drive_sent = time.monotonic()
 
     def stop(self) -> None:
         self.command(gen.Stop())
         self._last_drive = None
 
     def keepalive(self) -> None:
-        """Resend the drive command when nothing was sent for keepalive_s, well inside the
-        firmware's link-loss timeout; does nothing while stopped."""
-        if self._last_drive and time.monotonic() - self._last_sent >= self.keepalive_s:
+        """Send the drive command again when none was sent for keepalive_s, well inside the
+        firmware's link-loss timeout (only SET_DRIVE restarts it, not status polls); does
+        nothing while stopped."""
+        if self._last_drive and time.monotonic() - self._last_drive_sent >= self.keepalive_s:
             self.drive(*self._last_drive)
 
-    def set_config(self, link_timeout_ms: int, accel_limit: int = 0) -> None:
+    def set_config(self, link_timeout_ms: int,
+                   accel_limit: int = gen.DEFAULT_ACCEL_LIMIT) -> None:
         self.command(gen.SetConfig(link_timeout_ms=link_timeout_ms, accel_limit=accel_limit))
 
     def status(self) -> Any:
         """The robot's STATUS message."""
         return self._transact(gen.GetStatus(), lambda m, seq: isinstance(m, gen.Status) or (
-            isinstance(m, gen.Nack) and m.seq == seq))
+            isinstance(m, gen.Nack) and m.seq == seq), self._next_poll_seq())
 
     def close(self) -> None:
         """Stop the motors (best effort) and close the port."""

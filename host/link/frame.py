@@ -1,4 +1,4 @@
-"""Framing of the serial protocol: START LEN SEQ ID PAYLOAD CRC16 (docs/protocol.md).
+"""Framing of the serial protocol: START LEN SEQ ID PAYLOAD CRC (docs/protocol.md).
 
 The decoder mirrors the firmware's parser (protocol/c/frame.c): it rejects an oversize LEN as
 soon as it is read, never accepts a frame whose CRC fails, and after a rejected frame searches
@@ -13,12 +13,12 @@ import crcmod.predefined
 
 from host.link import protocol_gen as gen
 
-_crc16 = crcmod.predefined.mkCrcFun(gen.CRC_NAME)
+_crc = crcmod.predefined.mkCrcFun(gen.CRC_NAME)
 
 
-def crc16(data: bytes) -> int:
-    """CRC-16/CCITT-FALSE (poly 0x1021, init 0xFFFF) as the protocol uses it."""
-    return _crc16(data)
+def crc(data: bytes) -> int:
+    """The protocol's CRC (gen.CRC_NAME, CRC-32C) of LEN SEQ ID PAYLOAD."""
+    return _crc(data)
 
 
 @dataclass(frozen=True)
@@ -33,7 +33,7 @@ def encode_frame(seq: int, msg_id: int, payload: bytes) -> bytes:
     if len(payload) > gen.MAX_PAYLOAD:
         raise ValueError(f"payload of {len(payload)} bytes exceeds {gen.MAX_PAYLOAD}")
     body = bytes([len(payload), seq & 0xFF, msg_id & 0xFF]) + payload
-    return bytes([gen.START]) + body + crc16(body).to_bytes(2, "little")
+    return bytes([gen.START]) + body + crc(body).to_bytes(gen.CRC_LEN, "little")
 
 
 class FrameDecoder:
@@ -64,8 +64,8 @@ class FrameDecoder:
             need = gen.HEADER_LEN + self._buf[1] + gen.CRC_LEN
             if len(self._buf) < need:
                 continue
-            body, crc = bytes(self._buf[1:-2]), int.from_bytes(self._buf[-2:], "little")
-            if crc16(body) == crc:
+            body = bytes(self._buf[1:-gen.CRC_LEN])
+            if crc(body) == int.from_bytes(self._buf[-gen.CRC_LEN:], "little"):
                 self.good_frames += 1
                 frames.append(Frame(body[1], body[2], body[3:]))
                 self._buf.clear()

@@ -7,16 +7,18 @@ import enum
 from dataclasses import dataclass
 from typing import ClassVar
 
-SCHEMA_HASH = 0xB0CE5B41
+SCHEMA_HASH = 0xF490713D
 VERSION = 1
 BAUD = 115200
 START = 0xA5
 MAX_PAYLOAD = 24
 HEADER_LEN = 4  # START LEN SEQ ID
-CRC_LEN = 2
-CRC_NAME = "crc-ccitt-false"
+CRC_LEN = 4
+CRC_NAME = "crc-32c"
 DEFAULT_LINK_TIMEOUT_MS = 250
-DEFAULT_ACCEL_LIMIT = 0
+DEFAULT_ACCEL_LIMIT = 400
+DEFAULT_REVERSE_COAST_MS = 10
+DEFAULT_NACK_INTERVAL_MS = 10
 
 
 class Error(enum.IntEnum):
@@ -43,13 +45,13 @@ class AckResult(enum.IntEnum):
     """What an acknowledged command did (ACK.result)."""
 
     APPLIED = 0  # the command was applied
-    DUPLICATE = 1  # same SEQ and ID as the last command: acknowledged again, not applied twice (unless a link-loss stop came in between: then it is applied)
+    DUPLICATE = 1  # same SEQ, ID and payload as the last applied command: a resend, acknowledged again and not applied twice (after HELLO or a link-loss stop nothing counts as a resend)
 
 
 class StatusFlag(enum.IntFlag):
     """STATUS.flags bits."""
 
-    LINK_LOST = 1 << 0  # the motors were stopped because no valid frame came within the link timeout
+    LINK_LOST = 1 << 0  # the motors were stopped because no SET_DRIVE was accepted within the link timeout
     WATCHDOG_RESET = 1 << 1  # the last reset was a watchdog reset
     DRIVING = 1 << 2  # a drive command is in force (motors may be turning)
     ACCEL_LIMITED = 1 << 3  # the applied duty is still ramping towards the commanded duty
@@ -72,7 +74,7 @@ class Hello:
 
 @dataclass(frozen=True)
 class SetDrive:
-    """Command both motors' duty; also feeds the link timeout."""
+    """Command both motors' duty. An accepted SET_DRIVE (ACK APPLIED, or DUPLICATE of the one in force) is the only frame that restarts the link-loss deadline."""
 
     ID: ClassVar[int] = 0x02
     NAME: ClassVar[str] = "SET_DRIVE"
@@ -113,7 +115,7 @@ class SetConfig:
         "link_timeout_ms": (50, 5000),
         "accel_limit": (0, 10000),
     }
-    link_timeout_ms: int  # motors stop when no valid frame arrives for this long, ms
+    link_timeout_ms: int  # motors stop when no SET_DRIVE is accepted for this long, ms
     accel_limit: int  # largest duty change per 100 ms; 0 = no limit, permille per 100 ms
 
 
@@ -194,8 +196,8 @@ class Status:
     ID: ClassVar[int] = 0x84
     NAME: ClassVar[str] = "STATUS"
     DIRECTION: ClassVar[str] = "robot_to_host"
-    FORMAT: ClassVar[str] = "<IhhBBHHHHH"
-    SIZE: ClassVar[int] = 20
+    FORMAT: ClassVar[str] = "<IhhBBHHHHHHH"
+    SIZE: ClassVar[int] = 24
     RANGES: ClassVar[dict[str, tuple[int, int]]] = {
         "uptime_ms": (0, 4294967295),
         "left": (-32768, 32767),
@@ -207,6 +209,8 @@ class Status:
         "framing_errors": (0, 65535),
         "link_timeout_ms": (0, 65535),
         "accel_limit": (0, 65535),
+        "rx_overruns": (0, 65535),
+        "tx_dropped": (0, 65535),
     }
     uptime_ms: int  # time since reset, ms
     left: int  # left duty applied now, permille duty
@@ -218,6 +222,8 @@ class Status:
     framing_errors: int  # frames dropped for an oversize LEN (wraps)
     link_timeout_ms: int  # link-loss timeout in force, ms
     accel_limit: int  # acceleration limit in force, permille per 100 ms
+    rx_overruns: int  # received bytes lost to an overrun of the UART or the receive ring (wraps)
+    tx_dropped: int  # replies dropped because the transmit buffer was full (wraps)
 
 
 @dataclass(frozen=True)

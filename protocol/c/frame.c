@@ -1,7 +1,7 @@
 /* Byte-at-a-time frame parser and encoder; see frame.h. No allocation, no registers. */
 #include "frame.h"
 
-#include "crc16.h"
+#include "crc.h"
 
 void frame_parser_init(struct frame_parser *p)
 {
@@ -14,11 +14,20 @@ void frame_parser_init(struct frame_parser *p)
     p->last_id = 0;
 }
 
-static uint16_t crc_of(const uint8_t *data, uint8_t n)
+static uint32_t crc_of(const uint8_t *data, uint8_t n)
 {
-    uint16_t crc = PROTO_CRC_INIT;
+    uint32_t crc = PROTO_CRC_INIT;
     for (uint8_t i = 0; i < n; i++)
-        crc = crc16_update(crc, data[i]);
+        crc = crc_update(crc, data[i]);
+    return crc ^ PROTO_CRC_XOROUT;
+}
+
+/* The CRC field, little-endian. */
+static uint32_t crc_field(const uint8_t *p)
+{
+    uint32_t crc = 0;
+    for (uint8_t i = PROTO_CRC_LEN; i--;)
+        crc = crc << 8 | p[i];
     return crc;
 }
 
@@ -48,7 +57,7 @@ static uint8_t step(struct frame_parser *p, uint8_t byte, frame_handler handler,
             return 0;
         p->state = FRAME_WAIT_START;
         uint8_t n = p->count - PROTO_CRC_LEN;
-        uint16_t crc = (uint16_t)(p->buf[n] | ((uint16_t)p->buf[n + 1] << 8));
+        uint32_t crc = crc_field(&p->buf[n]);
         if (crc_of(p->buf, n) != crc) {
             p->crc_errors++;
             p->last_seq = p->buf[1];
@@ -98,8 +107,8 @@ uint8_t frame_encode(uint8_t *out, uint8_t seq, uint8_t id, const uint8_t *paylo
     out[3] = id;
     for (uint8_t i = 0; i < len; i++)
         out[4 + i] = payload[i];
-    uint16_t crc = crc_of(&out[1], (uint8_t)(3 + len));
-    out[4 + len] = (uint8_t)crc;
-    out[5 + len] = (uint8_t)(crc >> 8);
+    uint32_t crc = crc_of(&out[1], (uint8_t)(3 + len));
+    for (uint8_t i = 0; i < PROTO_CRC_LEN; i++, crc >>= 8)
+        out[4 + len + i] = (uint8_t)crc;
     return (uint8_t)(len + PROTO_HEADER_LEN + PROTO_CRC_LEN);
 }

@@ -6,17 +6,20 @@
 
 #include <stdint.h>
 
-#define PROTO_SCHEMA_HASH 0xB0CE5B41UL
+#define PROTO_SCHEMA_HASH 0xF490713DUL
 #define PROTO_VERSION 1
 #define PROTO_BAUD 115200UL
 #define PROTO_START 0xA5
 #define PROTO_MAX_PAYLOAD 24
 #define PROTO_HEADER_LEN 4 /* START LEN SEQ ID */
-#define PROTO_CRC_LEN 2
+#define PROTO_CRC_LEN 4
 #define PROTO_FRAME_MAX (PROTO_HEADER_LEN + PROTO_MAX_PAYLOAD + PROTO_CRC_LEN)
-#define PROTO_CRC_INIT 0xFFFFu /* CRC-16/CCITT-FALSE: _crc_xmodem_update from 0xFFFF */
+#define PROTO_CRC_INIT 0xFFFFFFFFUL /* CRC-32C (Castagnoli), reflected polynomial 0x82F63B78, init and final XOR 0xFFFFFFFF */
+#define PROTO_CRC_XOROUT 0xFFFFFFFFUL
 #define PROTO_DEFAULT_LINK_TIMEOUT_MS 250
-#define PROTO_DEFAULT_ACCEL_LIMIT 0
+#define PROTO_DEFAULT_ACCEL_LIMIT 400
+#define PROTO_DEFAULT_REVERSE_COAST_MS 10
+#define PROTO_DEFAULT_NACK_INTERVAL_MS 10
 
 /* Why a command was refused (NACK.error). */
 enum proto_error {
@@ -39,18 +42,18 @@ enum proto_reset_cause {
 /* What an acknowledged command did (ACK.result). */
 enum proto_ack_result {
     PROTO_ACK_RESULT_APPLIED = 0, /* the command was applied */
-    PROTO_ACK_RESULT_DUPLICATE = 1, /* same SEQ and ID as the last command: acknowledged again, not applied twice (unless a link-loss stop came in between: then it is applied) */
+    PROTO_ACK_RESULT_DUPLICATE = 1, /* same SEQ, ID and payload as the last applied command: a resend, acknowledged again and not applied twice (after HELLO or a link-loss stop nothing counts as a resend) */
 };
 
 /* STATUS.flags bits. */
-#define PROTO_STATUS_LINK_LOST (1u << 0) /* the motors were stopped because no valid frame came within the link timeout */
+#define PROTO_STATUS_LINK_LOST (1u << 0) /* the motors were stopped because no SET_DRIVE was accepted within the link timeout */
 #define PROTO_STATUS_WATCHDOG_RESET (1u << 1) /* the last reset was a watchdog reset */
 #define PROTO_STATUS_DRIVING (1u << 2) /* a drive command is in force (motors may be turning) */
 #define PROTO_STATUS_ACCEL_LIMITED (1u << 3) /* the applied duty is still ramping towards the commanded duty */
 
 enum proto_msg_id {
     PROTO_MSG_HELLO = 0x01, /* Start of a session: the robot answers HELLO_REPLY (not ACK). */
-    PROTO_MSG_SET_DRIVE = 0x02, /* Command both motors' duty; also feeds the link timeout. */
+    PROTO_MSG_SET_DRIVE = 0x02, /* Command both motors' duty. An accepted SET_DRIVE (ACK APPLIED, or DUPLICATE of the one in force) is the only frame that restarts the link-loss deadline. */
     PROTO_MSG_STOP = 0x03, /* Stop both motors at once (no ramp); they stay stopped until the next SET_DRIVE. */
     PROTO_MSG_SET_CONFIG = 0x04, /* Change the link-loss timeout and the acceleration limit. */
     PROTO_MSG_GET_STATUS = 0x05, /* Ask for a STATUS frame (sent instead of ACK). */
@@ -80,7 +83,7 @@ static inline void proto_hello_unpack(const uint8_t *p, struct proto_hello *m)
     m->nonce = (uint32_t)((uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24));
 }
 
-/* SET_DRIVE (0x02, host to robot): Command both motors' duty; also feeds the link timeout. */
+/* SET_DRIVE (0x02, host to robot): Command both motors' duty. An accepted SET_DRIVE (ACK APPLIED, or DUPLICATE of the one in force) is the only frame that restarts the link-loss deadline. */
 #define PROTO_SET_DRIVE_LEN 4
 #define PROTO_SET_DRIVE_LEFT_MIN (-1000)
 #define PROTO_SET_DRIVE_LEFT_MAX (1000)
@@ -121,7 +124,7 @@ static inline uint8_t proto_set_drive_in_range(const struct proto_set_drive *m)
 #define PROTO_SET_CONFIG_ACCEL_LIMIT_MIN (0)
 #define PROTO_SET_CONFIG_ACCEL_LIMIT_MAX (10000)
 struct proto_set_config {
-    uint16_t link_timeout_ms; /* motors stop when no valid frame arrives for this long, ms */
+    uint16_t link_timeout_ms; /* motors stop when no SET_DRIVE is accepted for this long, ms */
     uint16_t accel_limit; /* largest duty change per 100 ms; 0 = no limit, permille per 100 ms */
 };
 
@@ -223,7 +226,7 @@ static inline void proto_nack_unpack(const uint8_t *p, struct proto_nack *m)
 }
 
 /* STATUS (0x84, robot to host): The robot's state, in answer to GET_STATUS. */
-#define PROTO_STATUS_LEN 20
+#define PROTO_STATUS_LEN 24
 struct proto_status {
     uint32_t uptime_ms; /* time since reset, ms */
     int16_t left; /* left duty applied now, permille duty */
@@ -235,6 +238,8 @@ struct proto_status {
     uint16_t framing_errors; /* frames dropped for an oversize LEN (wraps) */
     uint16_t link_timeout_ms; /* link-loss timeout in force, ms */
     uint16_t accel_limit; /* acceleration limit in force, permille per 100 ms */
+    uint16_t rx_overruns; /* received bytes lost to an overrun of the UART or the receive ring (wraps) */
+    uint16_t tx_dropped; /* replies dropped because the transmit buffer was full (wraps) */
 };
 
 static inline void proto_status_pack(uint8_t *p, const struct proto_status *m)
@@ -259,6 +264,10 @@ static inline void proto_status_pack(uint8_t *p, const struct proto_status *m)
     p[17] = (uint8_t)((uint16_t)m->link_timeout_ms >> 8);
     p[18] = (uint8_t)((uint16_t)m->accel_limit);
     p[19] = (uint8_t)((uint16_t)m->accel_limit >> 8);
+    p[20] = (uint8_t)((uint16_t)m->rx_overruns);
+    p[21] = (uint8_t)((uint16_t)m->rx_overruns >> 8);
+    p[22] = (uint8_t)((uint16_t)m->tx_dropped);
+    p[23] = (uint8_t)((uint16_t)m->tx_dropped >> 8);
 }
 
 static inline void proto_status_unpack(const uint8_t *p, struct proto_status *m)
@@ -273,6 +282,8 @@ static inline void proto_status_unpack(const uint8_t *p, struct proto_status *m)
     m->framing_errors = (uint16_t)((uint16_t)p[14] | ((uint16_t)p[15] << 8));
     m->link_timeout_ms = (uint16_t)((uint16_t)p[16] | ((uint16_t)p[17] << 8));
     m->accel_limit = (uint16_t)((uint16_t)p[18] | ((uint16_t)p[19] << 8));
+    m->rx_overruns = (uint16_t)((uint16_t)p[20] | ((uint16_t)p[21] << 8));
+    m->tx_dropped = (uint16_t)((uint16_t)p[22] | ((uint16_t)p[23] << 8));
 }
 
 /* BOOT (0x85, robot to host): Sent once after every reset, unasked, so the host knows the board (re)started. */

@@ -8,7 +8,6 @@ import pytest
 
 from host.emulator import build
 from host.emulator.emulator import Emulator, PtyService
-from host.errors import HostError
 
 
 @pytest.fixture(params=["emulator", "simavr"])
@@ -23,7 +22,7 @@ def robot_port(request, tmp_path_factory) -> Iterator[str]:
     try:
         harness = build.simavr_harness(tmp_path_factory.mktemp("simavr"))
         elf = build.firmware_elf()
-    except HostError as e:
+    except build.ToolMissing as e:  # a build error is a failure, not a skip
         pytest.skip(str(e))
     with SimavrPty(harness, elf) as sim:
         yield sim.path

@@ -22,6 +22,7 @@ def test_handshake_reports_the_spec_hash_and_power_on(robot_port: str) -> None:
 
 def test_drive_status_and_stop(robot_port: str) -> None:
     with RobotLink(robot_port) as robot:
+        robot.set_config(link_timeout_ms=250, accel_limit=0)  # no ramp: the duty lands at once
         robot.drive(420, -130)
         s = robot.status()
         assert (s.left, s.right) == (420, -130) and s.flags & gen.StatusFlag.DRIVING
@@ -32,7 +33,7 @@ def test_drive_status_and_stop(robot_port: str) -> None:
 
 def test_link_loss_stops_the_motors(robot_port: str) -> None:
     with RobotLink(robot_port) as robot:
-        robot.set_config(link_timeout_ms=100)
+        robot.set_config(link_timeout_ms=100, accel_limit=0)
         robot.drive(500, 500)
         time.sleep(0.03)
         assert robot.status().left == 500
@@ -43,9 +44,10 @@ def test_link_loss_stops_the_motors(robot_port: str) -> None:
 
 def test_keepalive_holds_the_drive_past_the_timeout(robot_port: str) -> None:
     with RobotLink(robot_port, keepalive_s=0.03) as robot:
-        robot.set_config(link_timeout_ms=100)
+        # slack for a loaded test machine: a keepalive every 30 ms against a 200 ms timeout
+        robot.set_config(link_timeout_ms=200)
         robot.drive(300, 300)
-        end = time.monotonic() + 0.4
+        end = time.monotonic() + 0.7
         while time.monotonic() < end:
             robot.keepalive()
             time.sleep(0.005)
@@ -62,6 +64,35 @@ def test_a_resent_command_is_not_applied_twice(robot_port: str) -> None:
             robot._write(frame)
             replies.append(robot._await(lambda m: isinstance(m, gen.Ack) and m.seq == 77, 0.5))
         assert [r.result for r in replies] == [gen.AckResult.APPLIED, gen.AckResult.DUPLICATE]
+
+
+def test_status_polls_do_not_hold_the_drive_past_the_timeout(robot_port: str) -> None:
+    with RobotLink(robot_port) as robot:
+        robot.set_config(link_timeout_ms=100, accel_limit=0)
+        robot.drive(300, 300)
+        end = time.monotonic() + 0.3
+        while time.monotonic() < end:  # a host that only polls is not driving the robot
+            s = robot.status()
+            time.sleep(0.01)
+        assert (s.left, s.right) == (0, 0) and s.flags & gen.StatusFlag.LINK_LOST
+
+
+def test_a_new_command_with_an_old_seq_is_applied_not_taken_for_a_resend(
+        robot_port: str) -> None:
+    """The issue's counterexample: SET_DRIVE seq 10 at +300, 255 polls, SET_DRIVE seq 10 at
+    -300 must reverse the robot, not be acknowledged as a duplicate."""
+    with RobotLink(robot_port) as robot:
+        robot.set_config(link_timeout_ms=5000, accel_limit=0)
+        replies = []
+        for left in (300, -300):
+            robot._write(encode_frame(10, *pack(gen.SetDrive(left=left, right=left))))
+            # the answers to 255 polls take over half a second of line time: wait long enough
+            replies.append(robot._await(lambda m: isinstance(m, gen.Ack) and m.seq == 10, 3.0))
+            for seq in range(11, 11 + 255 if left > 0 else 11):
+                robot._write(encode_frame(seq & 0xFF, *pack(gen.GetStatus())))
+        assert [r.result for r in replies] == [gen.AckResult.APPLIED, gen.AckResult.APPLIED]
+        time.sleep(0.05)  # past the coast interval of the reversal
+        assert robot.status().left == -300
 
 
 def test_out_of_range_and_wrong_direction_are_refused(robot_port: str) -> None:

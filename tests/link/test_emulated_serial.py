@@ -10,16 +10,20 @@ import time
 import pytest
 
 from host.emulator.emulator import Emulator, Faults, PtyService
+from host.link import protocol_gen as gen
 from host.link.client import LinkError, RobotLink
 
 
 def test_every_command_gets_through_a_line_with_five_percent_corrupted_bytes() -> None:
     emu = Emulator(Faults(corrupt=0.05, seed=4))
-    with PtyService(emu) as service, RobotLink(service.path, retries=30,
+    # one byte in 20 corrupted: HELLO and its 25-byte reply both get through one try in six
+    with PtyService(emu) as service, RobotLink(service.path, retries=30, handshake_s=10,
                                                reply_timeout_s=0.02) as robot:
+        robot.set_config(link_timeout_ms=250, accel_limit=0)  # no ramp: this tests the link
         for i in range(80):
             left, right = (i * 37) % 2001 - 1000, -((i * 53) % 2001 - 1000)
             robot.drive(left, right)
+            time.sleep(gen.DEFAULT_REVERSE_COAST_MS * 1.5e-3)  # a reversal coasts first
             assert emu.motors() == (left, right)
         # some resends reached a robot that had already applied the command: it said so
         assert robot.duplicates > 0
@@ -29,6 +33,8 @@ def test_a_dropping_and_delaying_line_still_works() -> None:
     emu = Emulator(Faults(drop=0.03, delay_ms=5, seed=2))
     with PtyService(emu) as service, RobotLink(service.path, retries=30,
                                                reply_timeout_s=0.03) as robot:
+        # resends on this line can leave 250 ms without an accepted drive: a longer timeout
+        robot.set_config(link_timeout_ms=2000, accel_limit=0)
         for i in range(30):
             robot.drive(i * 10, -i * 10)
         assert robot.status().left == 290
@@ -53,6 +59,7 @@ def test_leaving_the_block_by_an_exception_stops_the_robot_at_once() -> None:
     with PtyService(emu) as service:
         with pytest.raises(RuntimeError):
             with RobotLink(service.path) as robot:
+                robot.set_config(link_timeout_ms=250, accel_limit=0)
                 robot.drive(700, 700)
                 assert emu.motors() == (700, 700)
                 raise RuntimeError("the vision loop failed")

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from host.link.frame import FrameDecoder, crc16
+from host.link.frame import FrameDecoder, crc
 from host.link.messages import describe
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -56,11 +56,12 @@ def test_vectors_cover_the_required_cases() -> None:
         assert f"message {cls.NAME}" in names
 
 
-def test_crc_is_ccitt_false_in_python_and_in_the_c_shim(native_build, tmp_path: Path) -> None:
-    assert crc16(b"123456789") == 0x29B1  # CRC-16/CCITT-FALSE check value
+def test_crc_is_crc32c_in_python_and_in_c(native_build, tmp_path: Path) -> None:
+    assert crc(b"123456789") == 0xE3069283  # CRC-32C check value
     src = tmp_path / "crc.c"
-    src.write_text('#include <stdio.h>\n#include "crc16.h"\n'
-                   'int main(void){uint16_t c=0xFFFF;const char*s="123456789";'
-                   'while(*s)c=crc16_update(c,(uint8_t)*s++);printf("%04X\\n",c);return 0;}\n')
+    src.write_text('#include <stdio.h>\n#include "crc.h"\n'
+                   'int main(void){uint32_t c=0xFFFFFFFF;const char*s="123456789";'
+                   'while(*s)c=crc_update(c,(uint8_t)*s++);printf("%08X\\n",c^0xFFFFFFFF);'
+                   'return 0;}\n')
     exe = native_build("crc", [src])
-    assert subprocess.run([str(exe)], capture_output=True, text=True).stdout.strip() == "29B1"
+    assert subprocess.run([str(exe)], capture_output=True, text=True).stdout.strip() == "E3069283"

@@ -1,7 +1,9 @@
-/* Motor outputs (implements board_motor_output). Duty 0 coasts: enable low, both inputs low. */
+/* Motor outputs (implements board_motor_output). Duty 0 coasts: enable low (bridge off), the
+ * direction inputs left as they were. */
 #include "motors.h"
 
 #include <avr/io.h>
+#include <util/atomic.h>
 
 #include "../config.h"
 #include "../core/board.h"
@@ -30,20 +32,33 @@ static uint16_t compare(int16_t duty)
     return (uint16_t)(magnitude * (PWM_TOP / 200) / 5);
 }
 
-static uint8_t direction(int16_t duty, uint8_t forward_bit, uint8_t reverse_bit)
+/* The direction inputs for a duty: a motor at zero keeps the inputs it had, since its enable
+ * (OCR 0) is what switches the bridge off; so the inputs change only together with a non-zero
+ * duty, which the core applies only after a coast interval at zero. Writing the inputs first
+ * and OCR1x second, the new duty reaches the pin at the timer's next TOP, after them. */
+static uint8_t direction(int16_t duty, uint8_t now, uint8_t forward_bit, uint8_t reverse_bit)
 {
-    return duty > 0 ? _BV(forward_bit) : duty < 0 ? _BV(reverse_bit) : 0;
+    if (duty > 0)
+        return _BV(forward_bit);
+    if (duty < 0)
+        return _BV(reverse_bit);
+    return now & (_BV(forward_bit) | _BV(reverse_bit));
 }
 
 void board_motor_output(int16_t left, int16_t right)
 {
     uint8_t mask = _BV(MOTOR_LEFT_IN1_BIT) | _BV(MOTOR_LEFT_IN2_BIT) |
                    _BV(MOTOR_RIGHT_IN3_BIT) | _BV(MOTOR_RIGHT_IN4_BIT);
-    uint8_t dir = direction(left, MOTOR_LEFT_IN1_BIT, MOTOR_LEFT_IN2_BIT) |
-                  direction(right, MOTOR_RIGHT_IN3_BIT, MOTOR_RIGHT_IN4_BIT);
     uint16_t a = compare(left), b = compare(right);
-    /* the three writes follow each other within a few cycles */
-    MOTOR_DIR_PORT = (uint8_t)((MOTOR_DIR_PORT & ~mask) | dir);
-    OCR1A = a;
-    OCR1B = b;
+    /* Called from the main loop and from the timer interrupt (the link-loss cut): the 16-bit
+     * OCR writes share the timer's TEMP register, so no interrupt may come between them. */
+    ATOMIC_BLOCK(ATOMIC_RESTORESTATE)
+    {
+        uint8_t now = MOTOR_DIR_PORT;
+        uint8_t dir = direction(left, now, MOTOR_LEFT_IN1_BIT, MOTOR_LEFT_IN2_BIT) |
+                      direction(right, now, MOTOR_RIGHT_IN3_BIT, MOTOR_RIGHT_IN4_BIT);
+        MOTOR_DIR_PORT = (uint8_t)((now & ~mask) | dir);
+        OCR1A = a;
+        OCR1B = b;
+    }
 }

@@ -1,9 +1,11 @@
 /* UART0: the receive interrupt only moves bytes into a ring, the main loop drains it; transmit
- * goes through a ring emptied by the data-register-empty interrupt. Implements board_tx. */
+ * goes through a ring emptied by the data-register-empty interrupt and never waits. Implements
+ * board_tx and the overrun and drop counters. */
 #include "uart.h"
 
 #include <avr/interrupt.h>
 #include <avr/io.h>
+#include <util/atomic.h>
 
 #include "../config.h"
 #include "../core/board.h"
@@ -16,6 +18,8 @@ static volatile uint8_t rx_buf[UART_RX_SIZE];
 static volatile uint8_t rx_head, rx_tail; /* ISR writes head, main loop writes tail */
 static volatile uint8_t tx_buf[UART_TX_SIZE];
 static volatile uint8_t tx_head, tx_tail; /* main loop writes head, ISR writes tail */
+static volatile uint16_t rx_overruns;      /* written by the receive interrupt only */
+static uint16_t tx_dropped;                /* main loop only */
 
 void uart_init(void)
 {
@@ -29,12 +33,16 @@ void uart_init(void)
 
 ISR(USART_RX_vect)
 {
+    if (UCSR0A & _BV(DOR0)) /* the UART lost a byte before this one: read before UDR0 */
+        rx_overruns++;
     uint8_t byte = UDR0;
     uint8_t next = (rx_head + 1) & RX_MASK;
-    if (next != rx_tail) { /* a full ring drops the byte; the frame's CRC then fails */
-        rx_buf[rx_head] = byte;
-        rx_head = next;
+    if (next == rx_tail) { /* a full ring drops the byte; the frame's CRC then fails */
+        rx_overruns++;
+        return;
     }
+    rx_buf[rx_head] = byte;
+    rx_head = next;
 }
 
 ISR(USART_UDRE_vect)
@@ -63,12 +71,28 @@ uint8_t uart_rx_waiting(void)
 
 void board_tx(const uint8_t *data, uint8_t n)
 {
-    for (uint8_t i = 0; i < n; i++) {
-        uint8_t next = (tx_head + 1) & TX_MASK;
-        while (next == tx_tail) /* full: the interrupt empties it at line rate */
-            ;
-        tx_buf[tx_head] = data[i];
-        tx_head = next;
-        UCSR0B |= _BV(UDRIE0);
+    uint8_t head = tx_head;
+    uint8_t room = (uint8_t)((tx_tail - head - 1) & TX_MASK);
+    if (room < n) { /* never wait for the line: drop the whole frame and count it */
+        tx_dropped++;
+        return;
     }
+    for (uint8_t i = 0; i < n; i++) {
+        tx_buf[head] = data[i];
+        head = (head + 1) & TX_MASK;
+    }
+    tx_head = head;
+    UCSR0B |= _BV(UDRIE0);
+}
+
+uint16_t board_rx_overruns(void)
+{
+    uint16_t n;
+    ATOMIC_BLOCK(ATOMIC_RESTORESTATE) { n = rx_overruns; }
+    return n;
+}
+
+uint16_t board_tx_dropped(void)
+{
+    return tx_dropped;
 }

@@ -1,10 +1,12 @@
-/* Drive state and acceleration limit; see drive.h. */
+/* Drive state, acceleration limit and reversal through a coast interval; see drive.h. */
 #include "drive.h"
+
+#include "protocol_gen.h"
 
 void drive_init(struct drive *d)
 {
-    d->target[DRIVE_LEFT] = d->target[DRIVE_RIGHT] = 0;
-    d->applied[DRIVE_LEFT] = d->applied[DRIVE_RIGHT] = 0;
+    for (uint8_t m = DRIVE_LEFT; m <= DRIVE_RIGHT; m++)
+        d->target[m] = d->applied[m] = 0, d->coast_ms[m] = 0;
     d->accel_limit = 0;
     d->budget = 0;
 }
@@ -17,9 +19,12 @@ void drive_command(struct drive *d, int16_t left, int16_t right)
 
 void drive_stop(struct drive *d)
 {
-    /* a stop is never ramped: it is how safety acts */
     drive_command(d, 0, 0);
-    d->applied[DRIVE_LEFT] = d->applied[DRIVE_RIGHT] = 0;
+    for (uint8_t m = DRIVE_LEFT; m <= DRIVE_RIGHT; m++) {
+        if (d->applied[m])
+            d->coast_ms[m] = PROTO_DEFAULT_REVERSE_COAST_MS;
+        d->applied[m] = 0;
+    }
     d->budget = 0;
 }
 
@@ -28,6 +33,18 @@ static int16_t approach(int16_t from, int16_t to, uint16_t step)
     if (to > from)
         return (uint16_t)(to - from) > step ? (int16_t)(from + step) : to;
     return (uint16_t)(from - to) > step ? (int16_t)(from - step) : to;
+}
+
+/* Where motor m may head now: towards zero first when the target has the other sign, and
+ * nowhere while it is still coasting at zero. */
+static int16_t goal(const struct drive *d, uint8_t m)
+{
+    int16_t from = d->applied[m], to = d->target[m];
+    if ((from > 0 && to < 0) || (from < 0 && to > 0))
+        return 0;
+    if (from == 0 && d->coast_ms[m])
+        return 0;
+    return to;
 }
 
 uint8_t drive_tick(struct drive *d, uint16_t elapsed_ms)
@@ -41,7 +58,13 @@ uint8_t drive_tick(struct drive *d, uint16_t elapsed_ms)
     }
     uint8_t changed = 0;
     for (uint8_t m = DRIVE_LEFT; m <= DRIVE_RIGHT; m++) {
-        int16_t next = approach(d->applied[m], d->target[m], step);
+        int16_t next = approach(d->applied[m], goal(d, m), step);
+        /* counted down after the move: zero was reached somewhere within the last tick, so the
+         * motor leaves it only once more than the coast interval has surely passed */
+        if (d->applied[m] && !next)
+            d->coast_ms[m] = PROTO_DEFAULT_REVERSE_COAST_MS;
+        else if (!next)
+            d->coast_ms[m] = d->coast_ms[m] > elapsed_ms ? d->coast_ms[m] - elapsed_ms : 0;
         changed |= next != d->applied[m];
         d->applied[m] = next;
     }

@@ -8,18 +8,30 @@
 #include "frame.h"
 #include "link.h"
 
+/* A resend is recognised by SEQ, ID and the whole payload; commands are at most this long. */
+#define LAST_PAYLOAD_MAX 4
+_Static_assert(PROTO_SET_DRIVE_LEN <= LAST_PAYLOAD_MAX && PROTO_SET_CONFIG_LEN <= LAST_PAYLOAD_MAX &&
+                   PROTO_STOP_LEN <= LAST_PAYLOAD_MAX,
+               "a command's payload must fit the resend check");
+
+/* Shared with the timer interrupt (robot_guard): touched in the main loop only under
+ * board_lock. */
+static struct link link;
+
 static struct {
     struct frame_parser parser;
     struct drive drive;
-    struct link link;
     uint32_t now_ms;
     uint32_t last_tick_ms;
     uint8_t reset_cause;
     uint8_t tx_seq;
-    uint8_t driving;    /* a SET_DRIVE is in force */
-    uint8_t have_last;  /* last_seq/last_id hold the last applied command */
+    uint8_t nack_credit; /* NACKs that may still be sent now (NACK_BURST at most) */
+    uint8_t nack_ms;     /* ms towards the next credit */
+    uint8_t have_last;   /* last_* hold the last applied command */
     uint8_t last_seq;
     uint8_t last_id;
+    uint8_t last_len;
+    uint8_t last_payload[LAST_PAYLOAD_MAX];
 } robot;
 
 static void send(uint8_t id, const uint8_t *payload, uint8_t len)
@@ -38,6 +50,9 @@ static void send_ack(uint8_t seq, uint8_t result)
 
 static void send_nack(uint8_t seq, uint8_t error)
 {
+    if (!robot.nack_credit)
+        return; /* rate-limited: a flood of bad frames must not crowd out the answers */
+    robot.nack_credit--;
     uint8_t p[PROTO_NACK_LEN];
     struct proto_nack m = {seq, error};
     proto_nack_pack(p, &m);
@@ -46,13 +61,21 @@ static void send_nack(uint8_t seq, uint8_t error)
 
 static void output(void)
 {
-    board_motor_output(robot.drive.applied[DRIVE_LEFT], robot.drive.applied[DRIVE_RIGHT]);
+    /* under the lock the guard cannot cut between the check and the write; once it has cut,
+     * only a new accepted SET_DRIVE (link_heard) lets the bridge be driven again */
+    uint8_t state = board_lock();
+    uint8_t on = link.armed;
+    board_motor_output(on ? robot.drive.applied[DRIVE_LEFT] : 0,
+                       on ? robot.drive.applied[DRIVE_RIGHT] : 0);
+    board_unlock(state);
 }
 
 static void stop(void)
 {
+    uint8_t state = board_lock();
+    link.armed = 0;
+    board_unlock(state);
     drive_stop(&robot.drive);
-    robot.driving = 0;
     output();
 }
 
@@ -61,7 +84,7 @@ static void on_hello(const uint8_t *payload)
     struct proto_hello in;
     proto_hello_unpack(payload, &in);
     struct proto_hello_reply m = {in.nonce, PROTO_SCHEMA_HASH, FW_VERSION, robot.reset_cause,
-                                  robot.link.timeout_ms};
+                                  link.timeout_ms};
     uint8_t p[PROTO_HELLO_REPLY_LEN];
     proto_hello_reply_pack(p, &m);
     send(PROTO_MSG_HELLO_REPLY, p, sizeof p);
@@ -75,12 +98,16 @@ static void on_set_drive(const struct frame *f)
     if (m.left == 999 && m.right == -999)
         for (;;) /* test build only: a hang the watchdog must catch */
             ;
+    if (m.left == 998 && m.right == -998) /* test build only: a stall in the main loop, */
+        for (volatile uint32_t i = 0; i < 30000UL; i++) /* long enough to fill the RX ring */
+            ;
 #endif
+    uint8_t state = board_lock();
+    link_heard(&link, robot.now_ms);
+    board_unlock(state);
     drive_command(&robot.drive, m.left, m.right);
-    robot.driving = 1;
-    robot.link.lost = 0;
-    if (drive_tick(&robot.drive, 0))
-        output();
+    drive_tick(&robot.drive, 0);
+    output();
     send_ack(f->seq, PROTO_ACK_RESULT_APPLIED);
 }
 
@@ -88,16 +115,18 @@ static void on_set_config(const struct frame *f)
 {
     struct proto_set_config m;
     proto_set_config_unpack(f->payload, &m);
-    robot.link.timeout_ms = m.link_timeout_ms;
+    uint8_t state = board_lock();
+    link.timeout_ms = m.link_timeout_ms;
+    board_unlock(state);
     robot.drive.accel_limit = m.accel_limit;
     send_ack(f->seq, PROTO_ACK_RESULT_APPLIED);
 }
 
 static uint8_t status_flags(void)
 {
-    return (robot.link.lost ? PROTO_STATUS_LINK_LOST : 0) |
+    return (link.lost ? PROTO_STATUS_LINK_LOST : 0) |
            (robot.reset_cause == PROTO_RESET_CAUSE_WATCHDOG ? PROTO_STATUS_WATCHDOG_RESET : 0) |
-           (robot.driving ? PROTO_STATUS_DRIVING : 0) |
+           (link.armed ? PROTO_STATUS_DRIVING : 0) |
            (drive_ramping(&robot.drive) ? PROTO_STATUS_ACCEL_LIMITED : 0);
 }
 
@@ -106,7 +135,8 @@ static void on_get_status(void)
     struct proto_status m = {
         robot.now_ms, robot.drive.applied[DRIVE_LEFT], robot.drive.applied[DRIVE_RIGHT],
         status_flags(), robot.reset_cause, robot.parser.good_frames, robot.parser.crc_errors,
-        robot.parser.framing_errors, robot.link.timeout_ms, robot.drive.accel_limit};
+        robot.parser.framing_errors, link.timeout_ms, robot.drive.accel_limit,
+        board_rx_overruns(), board_tx_dropped()};
     uint8_t p[PROTO_STATUS_LEN];
     proto_status_pack(p, &m);
     send(PROTO_MSG_STATUS, p, sizeof p);
@@ -134,10 +164,60 @@ static void dispatch(const struct frame *f)
     }
 }
 
+/* A command with the SEQ, ID and payload of the last applied one: a resend. */
+static uint8_t is_resend(const struct frame *f)
+{
+    if (!robot.have_last || f->seq != robot.last_seq || f->id != robot.last_id ||
+        f->len != robot.last_len)
+        return 0;
+    for (uint8_t i = 0; i < f->len; i++)
+        if (f->payload[i] != robot.last_payload[i])
+            return 0;
+    return 1;
+}
+
+static void remember(const struct frame *f)
+{
+    robot.have_last = 1;
+    robot.last_seq = f->seq;
+    robot.last_id = f->id;
+    robot.last_len = f->len;
+    for (uint8_t i = 0; i < f->len; i++)
+        robot.last_payload[i] = f->payload[i];
+}
+
+/* A resend of the SET_DRIVE in force is still that motion command: it refreshes the deadline. */
+static void on_resend(const struct frame *f)
+{
+    if (f->id == PROTO_MSG_SET_DRIVE) {
+        uint8_t state = board_lock();
+        if (link.armed)
+            link_heard(&link, robot.now_ms);
+        board_unlock(state);
+    }
+    send_ack(f->seq, PROTO_ACK_RESULT_DUPLICATE); /* do not apply twice */
+}
+
+/* When the guard has cut the motors, bring the drive state in line (before anything else may
+ * drive them again); returns 1 if it had. */
+static uint8_t catch_up_guard(void)
+{
+    uint8_t state = board_lock();
+    uint8_t tripped = link.tripped;
+    link.tripped = 0;
+    board_unlock(state);
+    if (!tripped)
+        return 0;
+    link.lost = 1;
+    robot.have_last = 0; /* a resend after this stop is applied again, not a duplicate */
+    stop();
+    return 1;
+}
+
 static void on_frame(void *ctx, const struct frame *f)
 {
-    (void)ctx;
-    link_heard(&robot.link, robot.now_ms);
+    (void)ctx; /* only an accepted SET_DRIVE refreshes the link-loss deadline, not any frame */
+    catch_up_guard();
     uint8_t error = proto_check(f->id, f->payload, f->len);
     if (!error && !proto_is_host_to_robot(f->id))
         error = PROTO_ERROR_WRONG_DIRECTION;
@@ -148,13 +228,11 @@ static void on_frame(void *ctx, const struct frame *f)
     if (f->id == PROTO_MSG_HELLO) {
         robot.have_last = 0; /* a new session numbers its commands afresh */
     } else if (f->id != PROTO_MSG_GET_STATUS) {
-        if (robot.have_last && f->seq == robot.last_seq && f->id == robot.last_id) {
-            send_ack(f->seq, PROTO_ACK_RESULT_DUPLICATE); /* a resend: do not apply twice */
+        if (is_resend(f)) {
+            on_resend(f);
             return;
         }
-        robot.have_last = 1;
-        robot.last_seq = f->seq;
-        robot.last_id = f->id;
+        remember(f);
     }
     dispatch(f);
 }
@@ -163,12 +241,16 @@ void robot_init(uint8_t reset_cause, uint32_t now_ms)
 {
     frame_parser_init(&robot.parser);
     drive_init(&robot.drive);
-    link_init(&robot.link, now_ms, PROTO_DEFAULT_LINK_TIMEOUT_MS);
+    uint8_t state = board_lock();
+    link_init(&link, now_ms, PROTO_DEFAULT_LINK_TIMEOUT_MS);
+    board_unlock(state);
     robot.drive.accel_limit = PROTO_DEFAULT_ACCEL_LIMIT;
     robot.now_ms = robot.last_tick_ms = now_ms;
     robot.reset_cause = reset_cause;
     robot.tx_seq = 0;
     robot.have_last = 0;
+    robot.nack_credit = NACK_BURST;
+    robot.nack_ms = 0;
     stop();
     struct proto_boot m = {reset_cause, FW_VERSION, PROTO_SCHEMA_HASH};
     uint8_t p[PROTO_BOOT_LEN];
@@ -184,17 +266,33 @@ void robot_rx_byte(uint8_t byte, uint32_t now_ms)
         send_nack(robot.parser.last_seq, PROTO_ERROR_BAD_CRC);
 }
 
+/* One NACK credit back every PROTO_DEFAULT_NACK_INTERVAL_MS, up to NACK_BURST. */
+static void refill_nacks(uint16_t elapsed)
+{
+    uint16_t ms = robot.nack_ms + elapsed;
+    while (ms >= PROTO_DEFAULT_NACK_INTERVAL_MS && robot.nack_credit < NACK_BURST) {
+        ms -= PROTO_DEFAULT_NACK_INTERVAL_MS;
+        robot.nack_credit++;
+    }
+    robot.nack_ms = robot.nack_credit < NACK_BURST ? (uint8_t)ms : 0;
+}
+
 void robot_tick(uint32_t now_ms)
 {
     robot.now_ms = now_ms;
     uint16_t elapsed = (uint16_t)(now_ms - robot.last_tick_ms);
     robot.last_tick_ms = now_ms;
-    if (robot.driving && link_expired(&robot.link, now_ms)) {
-        robot.link.lost = 1;
-        robot.have_last = 0; /* a resend after this stop is applied again, not a duplicate */
-        stop();
-        return;
-    }
-    if (drive_tick(&robot.drive, elapsed))
+    refill_nacks(elapsed);
+    if (!catch_up_guard() && drive_tick(&robot.drive, elapsed))
         output();
+}
+
+void robot_guard(uint32_t now_ms)
+{
+    /* the timer interrupt: the main loop only touches link under board_lock */
+    if (!link_expired(&link, now_ms))
+        return;
+    link.armed = 0;
+    link.tripped = 1;
+    board_motor_output(0, 0);
 }

@@ -4,16 +4,22 @@
  *   harness FIRMWARE.elf --pty     real time, UART0 bridged to a pseudo-terminal
  *
  * Scripted commands, one a line:
- *   send HEX     queue bytes for UART0, delivered at PROTO_BAUD once the UART says XON
+ *   send HEX     queue bytes for UART0, one every byte time at PROTO_BAUD
+ *   flow 1|0     1 (default): a byte goes in only while the UART says XON (never overruns);
+ *                0: at line rate whatever the UART says, as a host without flow control does,
+ *                so the receiver overruns when the firmware falls behind
  *   run MS       simulate MS milliseconds
  *   quiet 0|1    stop or start printing each "in" byte (counts are kept either way)
  * Events on stdout, times in CPU cycles since power-on:
  *   in CYCLE BYTE              a byte entered UART0 (its start bit)
  *   tx CYCLE BYTE              UART0 sent a byte
- *   pwm CYCLE OCR1A OCR1B DIR  a motor output changed (DIR = PD4..PD7 as a 4-bit number)
+ *   io CYCLE PORTB DDRB PORTD DDRD TCCR1A TCCR1B ICR1 OCR1A OCR1B MCUSR WDTCSR
+ *                              one of these registers changed (hex); the pins are derived from
+ *                              them (host/emulator/pins.py): simavr 1.6 does not report the
+ *                              Timer1 PWM toggles on PB1/PB2 (docs: shared simavr notes)
  *   reset CYCLE                the chip reset (the watchdog, in these tests)
  *   end CYCLE INS IN TX RESETS SECONDS   at the end of input
- * In --pty mode stdout has the one line "pty PATH"; the pwm and reset events go to stderr. */
+ * In --pty mode stdout has the one line "pty PATH"; the io and reset events go to stderr. */
 #define _GNU_SOURCE
 #include <fcntl.h>
 #include <poll.h>
@@ -33,25 +39,37 @@
 #define F_CPU 16000000UL
 #define CYCLES_PER_BYTE (10UL * F_CPU / PROTO_BAUD) /* the host's line: 10 bits a byte */
 
-/* ATmega328P data-space addresses (datasheet, register summary) */
-#define REG_PORTD 0x2B
-#define REG_OCR1AL 0x88
-#define REG_OCR1AH 0x89
-#define REG_OCR1BL 0x8A
-#define REG_OCR1BH 0x8B
-#define DIR_SHIFT 4 /* PD4..PD7: IN1 IN2 IN3 IN4 */
+/* ATmega328P data-space addresses of the watched registers (datasheet, register summary); a
+ * 16-bit register is listed by its low byte and printed whole */
+static const struct {
+    uint16_t addr;
+    uint8_t wide;
+} watched[] = {
+    {0x25, 0}, /* PORTB */
+    {0x24, 0}, /* DDRB */
+    {0x2B, 0}, /* PORTD */
+    {0x2A, 0}, /* DDRD */
+    {0x80, 0}, /* TCCR1A */
+    {0x81, 0}, /* TCCR1B */
+    {0x86, 1}, /* ICR1 */
+    {0x88, 1}, /* OCR1A */
+    {0x8A, 1}, /* OCR1B */
+    {0x54, 0}, /* MCUSR */
+    {0x60, 0}, /* WDTCSR */
+};
+#define N_WATCHED (sizeof watched / sizeof watched[0])
 
 static struct {
     avr_t *avr;
     avr_irq_t *uart_in;
-    int xon;
+    int xon, flow, feeding;
     uint8_t *queue; /* bytes waiting for UART0: queue[q_head..q_tail) */
     size_t q_head, q_tail, q_cap;
     avr_cycle_count_t next_in;
     int quiet, pty_fd;
-    FILE *events; /* pwm and reset lines */
+    FILE *events; /* io and reset lines */
     unsigned long n_in, n_tx, resets;
-    unsigned last_a, last_b, last_dir;
+    unsigned last[N_WATCHED];
 } h;
 
 static void on_tx(struct avr_irq_t *irq, uint32_t value, void *param)
@@ -83,27 +101,51 @@ static void no_sleep(avr_t *avr, avr_cycle_count_t how_long)
     (void)avr, (void)how_long; /* scripted mode runs as fast as it can */
 }
 
-static void feed_uart(void)
+/* Cycle timer: one byte into UART0 per byte time while the queue has bytes. A timer, not a
+ * check between instructions, so a byte arrives on time also while the CPU sleeps. */
+static avr_cycle_count_t inject(struct avr_t *avr, avr_cycle_count_t when, void *param)
 {
-    if (h.q_head == h.q_tail || !h.xon || h.avr->cycle < h.next_in)
-        return;
+    (void)param;
+    if (h.q_head == h.q_tail) {
+        h.feeding = 0;
+        return 0;
+    }
+    if (h.flow && !h.xon)
+        return when + CYCLES_PER_BYTE / 16; /* the UART is full: look again shortly */
     uint8_t byte = h.queue[h.q_head++];
     h.n_in++;
     if (h.pty_fd < 0 && !h.quiet)
-        printf("in %llu %02x\n", (unsigned long long)h.avr->cycle, byte);
-    h.next_in = h.avr->cycle + CYCLES_PER_BYTE;
+        printf("in %llu %02x\n", (unsigned long long)avr->cycle, byte);
     avr_raise_irq(h.uart_in, byte);
+    h.next_in = when + CYCLES_PER_BYTE;
+    return h.next_in;
 }
 
-static void watch_pins(void)
+static void start_feeding(void)
+{
+    if (h.feeding || h.q_head == h.q_tail)
+        return;
+    h.feeding = 1;
+    avr_cycle_count_t now = h.avr->cycle;
+    avr_cycle_timer_register(h.avr, h.next_in > now ? h.next_in - now : 1, inject, NULL);
+}
+
+static void watch_io(void)
 {
     const uint8_t *d = h.avr->data;
-    unsigned a = d[REG_OCR1AL] | d[REG_OCR1AH] << 8, b = d[REG_OCR1BL] | d[REG_OCR1BH] << 8;
-    unsigned dir = (d[REG_PORTD] >> DIR_SHIFT) & 0x0F;
-    if (a == h.last_a && b == h.last_b && dir == h.last_dir)
+    int changed = 0;
+    for (size_t i = 0; i < N_WATCHED; i++) {
+        uint16_t a = watched[i].addr;
+        unsigned v = d[a] | (watched[i].wide ? d[a + 1] << 8 : 0);
+        changed |= v != h.last[i];
+        h.last[i] = v;
+    }
+    if (!changed)
         return;
-    h.last_a = a, h.last_b = b, h.last_dir = dir;
-    fprintf(h.events, "pwm %llu %u %u %u\n", (unsigned long long)h.avr->cycle, a, b, dir);
+    fprintf(h.events, "io %llu", (unsigned long long)h.avr->cycle);
+    for (size_t i = 0; i < N_WATCHED; i++)
+        fprintf(h.events, " %x", h.last[i]);
+    fputc('\n', h.events);
 }
 
 static int step(void)
@@ -117,15 +159,24 @@ static int step(void)
     if (h.avr->pc == 0 && pc != 0) {
         h.resets++;
         h.xon = 0; /* hold bytes until the reset firmware enables its UART again */
+        h.feeding = 0; /* the reset dropped the cycle timers */
+        start_feeding();
         fprintf(h.events, "reset %llu\n", (unsigned long long)h.avr->cycle);
     }
-    feed_uart();
-    watch_pins();
+    watch_io();
     return 0;
+}
+
+static avr_cycle_count_t wake(struct avr_t *avr, avr_cycle_count_t when, void *param)
+{
+    (void)avr, (void)when, (void)param;
+    return 0; /* nothing to do: the timer only ends a sleep at the end of a run */
 }
 
 static int run_until(avr_cycle_count_t end)
 {
+    if (end > h.avr->cycle) /* a sleeping CPU would otherwise run on to its next interrupt */
+        avr_cycle_timer_register(h.avr, end - h.avr->cycle, wake, NULL);
     while (h.avr->cycle < end)
         if (step() < 0)
             return -1;
@@ -145,6 +196,7 @@ static void queue_byte(uint8_t byte)
         }
     }
     h.queue[h.q_tail++] = byte;
+    start_feeding();
 }
 
 static void queue_hex(const char *hex)
@@ -169,6 +221,7 @@ static int scripted(void)
     char *line = NULL;
     size_t cap = 0;
     double t0 = wall();
+    watch_io(); /* the registers at power-on */
     while (getline(&line, &cap, stdin) > 0) {
         char cmd[16];
         double arg = 0;
@@ -178,6 +231,8 @@ static int scripted(void)
             queue_hex(line + 5);
         else if (!strcmp(cmd, "quiet") && sscanf(line + 6, "%lf", &arg) == 1)
             h.quiet = arg != 0;
+        else if (!strcmp(cmd, "flow") && sscanf(line + 5, "%lf", &arg) == 1)
+            h.flow = arg != 0;
         else if (!strcmp(cmd, "run") && sscanf(line + 4, "%lf", &arg) == 1) {
             if (run_until(h.avr->cycle + (avr_cycle_count_t)(arg * F_CPU / 1000)) < 0)
                 return 1;
@@ -251,7 +306,9 @@ int main(int argc, char **argv)
     avr_load_firmware(h.avr, &fw);
     h.avr->frequency = F_CPU;
     h.pty_fd = -1;
-    h.last_a = h.last_b = h.last_dir = ~0u; /* the first step prints the outputs at power-on */
+    h.flow = 1;
+    for (size_t i = 0; i < N_WATCHED; i++)
+        h.last[i] = ~0u; /* the first step prints the registers at power-on */
     uint32_t flags = 0; /* no console echo of UART output */
     avr_ioctl(h.avr, AVR_IOCTL_UART_SET_FLAGS('0'), &flags);
     h.uart_in = avr_io_getirq(h.avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_INPUT);
