@@ -13,6 +13,8 @@ from pathlib import Path
 
 import pytest
 
+from host.link.protocol_gen import SCHEMA_HASH
+
 HERE = Path(__file__).parent
 
 
@@ -53,7 +55,7 @@ def test_page_shows_pictures_and_overlays(run):
     assert first["left_loaded"] == 320 and first["disparity_loaded"] == 320
     assert later["target"].startswith("target ") and " px" in later["target"]
     assert later["target"].endswith(" m")
-    assert later["robot"] is not None and later["hash"] == "0xB0CE5B41"
+    assert later["robot"] is not None and later["hash"] == f"0x{SCHEMA_HASH:08X}"
     assert later["rtt"].endswith(" ms")
     assert (out / "view.png").stat().st_size > 20_000
 
