@@ -73,9 +73,7 @@ class SimulatedUno:
         self.flash = flash
         self.resets: list[Reset] = []
         self.saves: list[int] = []  # bytes programmed, at each save of the flash file
-        self._ocr = (0, 0)
-        self._dir = 0
-        self._cycle = 0
+        self.pwm: list[tuple[int, int, int, int]] = []  # (cycle, OCR1A, OCR1B, PD4..PD7)
         self._cond = threading.Condition()
         args = [str(exe), str(bootloader), str(flash)] + ([] if autoreset else ["--no-autoreset"])
         self._proc = subprocess.Popen(args,
@@ -97,8 +95,8 @@ class SimulatedUno:
                 if kind == "reset":
                     self.resets.append(Reset(int(rest[0]), int(rest[1], 16)))
                 elif kind == "pwm":
-                    self._cycle = int(rest[0])
-                    self._ocr, self._dir = (int(rest[1]), int(rest[2])), int(rest[3])
+                    c, a, b, d = map(int, rest)
+                    self.pwm.append((c, a, b, d))
                 elif kind == "saved":
                     self.saves.append(int(rest[0]))
                 self._cond.notify_all()
@@ -112,7 +110,7 @@ class SimulatedUno:
         """Duty (permille) the flashed firmware applies to the left and right motor, read from
         OCR1A/OCR1B and the direction pins PD4..PD7."""
         with self._cond:
-            (a, b), d = self._ocr, self._dir
+            _, a, b, d = self.pwm[-1] if self.pwm else (0, 0, 0, 0)
         return duty(a, bool(d & 1), bool(d & 2)), duty(b, bool(d & 4), bool(d & 8))
 
     def advance(self, ms: float) -> None:
@@ -140,3 +138,23 @@ class SimulatedUno:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+def avrdude(port: str, hex_file: Path, timeout_s: float = 90,
+            extra: tuple[str, ...] = ()) -> subprocess.CompletedProcess:
+    """Upload hex_file through an Uno's bootloader, as `make flash` does; output in .stderr."""
+    build._need("avrdude", "avrdude")
+    return subprocess.run(["avrdude", "-p", "atmega328p", "-c", "arduino", "-P", port,
+                           "-b", "115200", *extra, "-U", f"flash:w:{hex_file}:i"],
+                          capture_output=True, text=True, timeout=timeout_s)
+
+
+def hex_image(hex_file: Path) -> dict[int, int]:
+    """Address -> byte of the data records of an Intel HEX file (to compare with the flash)."""
+    image: dict[int, int] = {}
+    for line in hex_file.read_text().split():
+        raw = bytes.fromhex(line[1:])
+        if raw[3] == 0:
+            base = int.from_bytes(raw[1:3], "big")
+            image.update((base + i, b) for i, b in enumerate(raw[4:4 + raw[0]]))
+    return image
