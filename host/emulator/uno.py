@@ -5,12 +5,12 @@ from __future__ import annotations
 
 import subprocess
 import threading
-import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 from host.emulator import build
+from host.emulator.board import MotorPins, WallClock
 from host.errors import HostError
 
 # Debian's arduino-core-avr: optiboot 4.4, the bootloader Unos carry
@@ -18,7 +18,6 @@ OPTIBOOT = Path("/usr/share/arduino/hardware/arduino/avr/bootloaders/optiboot/"
                 "optiboot_atmega328.hex")
 SOURCE = build.FIRMWARE / "simavr" / "uno.c"
 F_CPU = 16_000_000
-PWM_TOP = 400  # ICR1, firmware/atmega328/config.h
 MCUSR_BITS = {0x01: "PORF", 0x02: "EXTRF", 0x04: "BORF", 0x08: "WDRF"}
 
 
@@ -37,12 +36,6 @@ def program(out_dir: Path) -> Path:
     if r.returncode:
         raise RuntimeError(f"building the simulated Uno failed:\n{r.stderr}")
     return exe
-
-
-def duty(ocr: int, forward: bool, reverse: bool) -> int:
-    """Duty in permille from a Timer1 compare value and the bridge's two direction inputs."""
-    magnitude = ocr * 1000 // PWM_TOP
-    return magnitude if forward and not reverse else -magnitude if reverse and not forward else 0
 
 
 @dataclass(frozen=True)
@@ -73,7 +66,8 @@ class SimulatedUno:
         self.flash = flash
         self.resets: list[Reset] = []
         self.saves: list[int] = []  # bytes programmed, at each save of the flash file
-        self.pwm: list[tuple[int, int, int, int]] = []  # (cycle, OCR1A, OCR1B, PD4..PD7)
+        self.pins = MotorPins()
+        self._clock = WallClock()
         self._cond = threading.Condition()
         args = [str(exe), str(bootloader), str(flash)] + ([] if autoreset else ["--no-autoreset"])
         self._proc = subprocess.Popen(args,
@@ -95,8 +89,7 @@ class SimulatedUno:
                 if kind == "reset":
                     self.resets.append(Reset(int(rest[0]), int(rest[1], 16)))
                 elif kind == "pwm":
-                    c, a, b, d = map(int, rest)
-                    self.pwm.append((c, a, b, d))
+                    self.pins.feed(line)
                 elif kind == "saved":
                     self.saves.append(int(rest[0]))
                 self._cond.notify_all()
@@ -109,13 +102,11 @@ class SimulatedUno:
     def motors(self) -> tuple[int, int]:
         """Duty (permille) the flashed firmware applies to the left and right motor, read from
         OCR1A/OCR1B and the direction pins PD4..PD7."""
-        with self._cond:
-            _, a, b, d = self.pwm[-1] if self.pwm else (0, 0, 0, 0)
-        return duty(a, bool(d & 1), bool(d & 2)), duty(b, bool(d & 4), bool(d & 8))
+        return self.pins.motors()
 
     def advance(self, ms: float) -> None:
         """Let ms of the board's time pass. The board runs on the wall clock, so this waits."""
-        time.sleep(ms / 1000)
+        self._clock.advance(ms)
 
     def stderr(self) -> str:
         """What the simulator said on stderr (after close)."""

@@ -4,6 +4,7 @@ clearly and leave a board that a good upload recovers, and the reset cause survi
 
 from __future__ import annotations
 
+import csv
 import shutil
 import subprocess
 import time
@@ -179,7 +180,47 @@ def test_a_watchdog_reset_is_reported_and_the_motors_stop_before_it(flashed_hang
                                     "hung; the watchdog stopped the motors and reset the board")
         assert uno.motors() == (0, 0)
     # at the pins: driven, stopped by the watchdog interrupt, reset one watchdog period later
-    drive = next(c for c, a, b, _ in uno.pwm if a == b == 200)
-    stop = next(c for c, a, b, _ in uno.pwm if a == b == 0 and c > drive)
+    drive = next(c for c, a, b, _ in uno.pins.events if a == b == 200)
+    stop = next(c for c, a, b, _ in uno.pins.events if a == b == 0 and c > drive)
     reset = next(r for r in uno.resets if r.cycle > stop)
     assert reset.flags == "WDRF" and 40 <= (reset.cycle - stop) / MS <= 80
+
+
+# --- the real firmware in the simulated world (host servo --sim --robot simavr|uno) ---
+
+
+@pytest.mark.parametrize("robot", ["simavr", "uno"])
+def test_the_avr_boards_show_the_motor_duty_the_firmware_applies(robot, flashed, tmp_path) -> None:
+    if robot == "uno":
+        board = _board(tmp_path / "flash.bin", flashed)
+    else:
+        from host.emulator.simavr import SimavrPty
+
+        try:
+            harness = build.simavr_harness(tmp_path)
+            elf = build.firmware_elf()
+        except HostError as e:
+            pytest.skip(str(e))
+        board = SimavrPty(harness, elf)
+    with board, RobotLink(board.path) as robot_link:
+        assert board.motors() == (0, 0)
+        robot_link.drive(420, -130)
+        deadline = time.monotonic() + 1
+        while board.motors() != (420, -130) and time.monotonic() < deadline:
+            board.advance(5)
+        assert board.motors() == (420, -130)
+
+
+def test_the_flashed_firmware_holds_the_simulated_robot_at_the_target(flashed, tmp_path) -> None:
+    shutil.copy(flashed, tmp_path / "flash.bin")
+    log = tmp_path / "run.csv"
+    r = subprocess.run([str(ROOT / ".venv" / "bin" / "host"), "servo", "--sim", "--robot", "uno",
+                        "--flash", str(tmp_path / "flash.bin"), "--start-depth", "0.9",
+                        "--border", "clip", "--num-disp", "48", "--log", str(log)],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert "held at disparity" in r.stderr
+    rows = list(csv.DictReader(log.open()))
+    assert rows[-1]["phase"] == "hold" and (rows[-1]["left"], rows[-1]["right"]) == ("0", "0")
+    assert any(int(row["left"]) != 0 for row in rows)  # the firmware drove it there
+    assert abs(float(rows[-1]["truth_depth_m"]) - 1.2) < 0.03
