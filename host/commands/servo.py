@@ -81,6 +81,9 @@ class _Status:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.robot != "emulator" and not args.sim:
+        raise HostError(f"--robot {args.robot} puts a simulated board in the simulated world: "
+                        f"it needs --sim")
     if args.sim:
         args.camera, args.port = "sim", args.port or "emulator"
     if not args.port:

@@ -3,6 +3,7 @@ application flash kept in a file, UART0 on a pty that avrdude programs and the h
 
 from __future__ import annotations
 
+import os
 import subprocess
 import threading
 from collections.abc import Callable
@@ -30,11 +31,13 @@ def program(out_dir: Path) -> Path:
     if exe.exists() and exe.stat().st_mtime >= SOURCE.stat().st_mtime:
         return exe
     out_dir.mkdir(parents=True, exist_ok=True)
+    tmp = out_dir / f"simavr-uno.{os.getpid()}"  # then renamed: a running board keeps its file
     r = subprocess.run(["gcc", "-std=gnu11", "-O2", "-Wall", "-Wextra", "-Werror",
-                        f"-I{build.SIMAVR_INCLUDE}", str(SOURCE), "-lsimavr", "-o", str(exe)],
+                        f"-I{build.SIMAVR_INCLUDE}", str(SOURCE), "-lsimavr", "-o", str(tmp)],
                        capture_output=True, text=True)
     if r.returncode:
         raise RuntimeError(f"building the simulated Uno failed:\n{r.stderr}")
+    os.replace(tmp, exe)
     return exe
 
 

@@ -1,4 +1,4 @@
-/* A simulated Arduino Uno: ATmega328P at 16 MHz with the Uno's own bootloader, for avrdude and the host.
+/* A simulated Arduino Uno: ATmega328P, 16 MHz, the Uno's own bootloader; for avrdude and the host.
  *
  *   uno OPTIBOOT.hex FLASH.bin [--no-autoreset]
  *
@@ -9,9 +9,12 @@
  *
  * UART0 is bridged to a pseudo-terminal. Opening the port resets the chip with EXTRF set, as the
  * Uno's DTR auto-reset circuit does when a program opens the serial port (a pty has no DTR line,
- * so the open itself is the edge); --no-autoreset is a board whose RESET-EN trace is cut, so
- * that a program can open the port and find the chip as it powered up. The simulation follows the wall clock, so optiboot's 1 s wait
- * and the firmware's timeouts are real seconds for avrdude and the host.
+ * so the open itself is the edge: the bridge is our own, not simavr's uart_pty part, because it
+ * must see the port being opened). --no-autoreset is a board whose RESET-EN trace is cut, so a
+ * program can open the port and find the chip as it powered up. The simulation follows the wall
+ * clock, so optiboot's 1 s wait and the firmware's timeouts are real seconds for avrdude and the
+ * host; simavr's sleeping on each empty poll of the UART is off, and so is its own real-time
+ * sleep while the AVR sleeps (the throttle does the waiting).
  *
  * stdout, one line each:
  *   pty PATH                    first, once the port exists
