@@ -30,6 +30,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/inotify.h>
 #include <termios.h>
 #include <time.h>
 #include <unistd.h>
@@ -58,7 +59,7 @@ static struct {
     avr_t *avr;
     avr_irq_t *uart_in;
     int xon, master, client; /* client: a program has the port open */
-    int autoreset;
+    int inotify, opens, autoreset; /* opens: the port's open file descriptions */
     uint8_t queue[4096];     /* bytes from the port waiting for UART0: queue[head..tail) */
     size_t head, tail;
     avr_cycle_count_t next_in, elapsed; /* elapsed: cycles before the last reset */
@@ -228,21 +229,47 @@ static int step(void)
     return 0;
 }
 
-/* Read what the client wrote; notice the port being opened (reset) or closed. */
+/* A program opened the port: DTR goes active, and the auto-reset circuit pulses RESET. */
+static void port_opened(void)
+{
+    tcflush(u.master, TCOFLUSH); /* nothing from before the open reaches the new client */
+    u.head = u.tail = 0;
+    if (u.autoreset)
+        reset(MCUSR_EXTRF);
+}
+
+/* Opens and closes of the port, in order, from inotify: a close and a quick reopen between two
+ * looks at the port are both seen. */
+static void watch_opens(void)
+{
+    char buf[4096] __attribute__((aligned(__alignof__(struct inotify_event))));
+    ssize_t n;
+    while ((n = read(u.inotify, buf, sizeof buf)) > 0) {
+        for (char *p = buf; p < buf + n; p += sizeof(struct inotify_event)
+                                             + ((struct inotify_event *)p)->len) {
+            uint32_t mask = ((struct inotify_event *)p)->mask;
+            if (mask & IN_OPEN && u.opens++ == 0)
+                port_opened();
+            if (mask & IN_CLOSE && u.opens > 0)
+                u.opens--;
+        }
+    }
+}
+
+/* Notice the port being opened or closed; read what the client wrote. */
 static void serve_port(void)
 {
     struct pollfd p = {.fd = u.master, .events = POLLIN};
     poll(&p, 1, 0);
-    int open_now = !(p.revents & POLLHUP);
-    if (open_now && !u.client) {
-        tcflush(u.master, TCIOFLUSH); /* nothing from before the open reaches the new client */
-        u.head = u.tail = 0;
-        u.client = 1;
-        if (u.autoreset)
-            reset(MCUSR_EXTRF); /* DTR goes active on open: the auto-reset pulse */
-    } else if (!open_now && u.client) {
-        u.client = 0;
+    if (u.inotify >= 0) {
+        watch_opens();
+    } else { /* no inotify: an open is seen if the port stays open until the next look */
+        int open_now = !(p.revents & POLLHUP);
+        if (open_now && !u.opens)
+            port_opened();
+        u.opens = open_now;
     }
+    u.client = u.opens > 0;
     if (!u.client || !(p.revents & POLLIN))
         return;
     if (u.head == u.tail)
@@ -272,6 +299,11 @@ static int open_pty(void)
     cfmakeraw(&tio);
     tcsetattr(slave, TCSANOW, &tio);
     close(slave);
+    u.inotify = inotify_init1(IN_NONBLOCK);
+    if (u.inotify >= 0 && inotify_add_watch(u.inotify, name, IN_OPEN | IN_CLOSE) < 0) {
+        close(u.inotify);
+        u.inotify = -1;
+    }
     fcntl(master, F_SETFL, O_NONBLOCK);
     printf("pty %s\n", name);
     return master;
