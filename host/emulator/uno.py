@@ -56,13 +56,14 @@ class SimulatedUno:
 
     Opening the port resets the chip through its bootloader (the Uno's DTR auto-reset); the
     application section lives in flash (a file; absent = an erased chip) and is saved when the
-    bootloader has written it. autoreset=False: the board's RESET-EN trace cut, opening the port
+    bootloader has written it. bootloader=None: a chip flashed over ISP, which starts the
+    application directly. autoreset=False: the board's RESET-EN trace cut, opening the port
     leaves the chip running. Events (resets, motor outputs, saves) are read as they come.
     """
 
     def __init__(self, flash: Path, out_dir: Path = build.ROOT / "build" / "simavr",
-                 bootloader: Path = OPTIBOOT, autoreset: bool = True) -> None:
-        if not bootloader.exists():
+                 bootloader: Path | None = OPTIBOOT, autoreset: bool = True) -> None:
+        if bootloader is not None and not bootloader.exists():
             raise HostError(f"the Uno's bootloader {bootloader} is missing: install "
                             "arduino-core-avr (make system-deps, as root)")
         exe = program(out_dir)
@@ -72,8 +73,8 @@ class SimulatedUno:
         self.pins = MotorPins()
         self._clock = WallClock()
         self._cond = threading.Condition()
-        args = [str(exe), str(bootloader), str(flash)] + ([] if autoreset else ["--no-autoreset"])
-        self._proc = subprocess.Popen(args,
+        args = [str(exe), str(bootloader or "-"), str(flash)]
+        self._proc = subprocess.Popen(args + ([] if autoreset else ["--no-autoreset"]),
                                       stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         assert self._proc.stdout is not None
         first = self._proc.stdout.readline().split()

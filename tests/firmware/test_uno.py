@@ -161,6 +161,16 @@ def test_a_port_open_resets_through_the_bootloader_and_is_not_mistaken(flashed, 
         assert [r.flags for r in uno.resets] == ["PORF", "EXTRF", "WDRF", "EXTRF", "WDRF"]
 
 
+@pytest.mark.parametrize(("autoreset", "cause"), [(False, gen.ResetCause.POWER_ON),
+                                                   (True, gen.ResetCause.EXTERNAL)])
+def test_with_no_bootloader_mcusr_tells_power_on_from_a_port_open(flashed, tmp_path, autoreset,
+                                                                    cause) -> None:
+    # the same application image on a chip flashed over ISP: MCUSR reaches the firmware intact
+    with _board(tmp_path / "flash.bin", flashed, bootloader=None, autoreset=autoreset) as uno:
+        with RobotLink(uno.path) as robot:
+            assert robot.hello.reset_cause == cause
+
+
 @pytest.fixture(scope="module")
 def flashed_hang(tmp_path_factory) -> Path:
     """An Uno's flash after uploading the TEST_HANG build (hangs on SET_DRIVE 999,-999)."""

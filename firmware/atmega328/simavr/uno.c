@@ -3,7 +3,8 @@
  *   uno OPTIBOOT.hex FLASH.bin [--no-autoreset]
  *
  * OPTIBOOT.hex is the bootloader (optiboot_atmega328.hex, loaded at its own address, 0x7E00); the
- * reset vector points there, as the Uno's BOOTRST fuse makes it. FLASH.bin holds the application
+ * reset vector points there, as the Uno's BOOTRST fuse makes it. OPTIBOOT.hex "-" is a chip with
+ * no bootloader (flashed over ISP, BOOTRST unprogrammed): it resets to 0x0000. FLASH.bin holds the application
  * section (0x0000-0x7DFF, erased = 0xFF): read at start if it exists, written back whenever the
  * bootloader has changed it (checked at each reset and on exit), so a flashed board stays flashed.
  *
@@ -347,9 +348,10 @@ int main(int argc, char **argv)
     u.avr->frequency = F_CPU;
     u.flash_path = argv[2];
     u.avr->codeend = FLASH_END;
-    if (load_application() < 0 || load_bootloader(argv[1]) < 0)
+    int bootloader = strcmp(argv[1], "-") != 0;
+    if (load_application() < 0 || (bootloader && load_bootloader(argv[1]) < 0))
         return 2;
-    u.avr->reset_pc = BOOT_BASE; /* BOOTRST programmed: reset enters the bootloader */
+    u.avr->reset_pc = bootloader ? BOOT_BASE : 0; /* BOOTRST programmed: enter the bootloader */
     u.avr->sleep = no_sleep;
     u.last_a = u.last_b = u.last_dir = ~0u;
     uint32_t flags = 0; /* no console echo, and no sleeping on each empty poll of RXC */
