@@ -234,3 +234,26 @@ def test_the_flashed_firmware_holds_the_simulated_robot_at_the_target(flashed, t
     assert rows[-1]["phase"] == "hold" and (rows[-1]["left"], rows[-1]["right"]) == ("0", "0")
     assert any(int(row["left"]) != 0 for row in rows)  # the firmware drove it there
     assert abs(float(rows[-1]["truth_depth_m"]) - 1.2) < 0.03
+
+
+def test_host_emulate_uno_prints_its_port_and_keeps_the_flash(flashed, tmp_path) -> None:
+    shutil.copy(flashed, tmp_path / "flash.bin")
+    before = (tmp_path / "flash.bin").read_bytes()
+    proc = subprocess.Popen([str(ROOT / ".venv" / "bin" / "host"), "emulate", "--uno", "--flash",
+                             str(tmp_path / "flash.bin"), "--duration", "4"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    port = proc.stdout.readline().strip()
+    with RobotLink(port) as robot:
+        assert robot.hello.schema_hash == gen.SCHEMA_HASH
+    _, err = proc.communicate(timeout=30)
+    assert proc.returncode == 0, err
+    assert "(PORF)" in err and "(EXTRF)" in err  # powered up, then reset by the port's opening
+    assert (tmp_path / "flash.bin").read_bytes() == before
+
+
+def test_host_emulate_uno_refuses_a_flash_file_of_the_wrong_size(tmp_path) -> None:
+    (tmp_path / "flash.bin").write_bytes(b"\x0c\x94" * 10)
+    r = subprocess.run([str(ROOT / ".venv" / "bin" / "host"), "emulate", "--uno", "--flash",
+                        str(tmp_path / "flash.bin")], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and r.stderr.count("\n") == 1
+    assert "is not a 32256-byte application image" in r.stderr
