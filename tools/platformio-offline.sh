@@ -12,7 +12,8 @@
 # user's home and nothing comes from PlatformIO's registry. On a machine that reaches the registry,
 # leave PLATFORMIO_CORE_DIR unset and `pio run` fetches the stock packages for the same platformio.ini.
 #
-# Exit status: 0 ready; 3 the platform snapshot is absent (tests skip, saying so); 1 anything else.
+# Exit status: 0 ready; 3 the platform snapshot or Debian's AVR tools are absent (the tests skip,
+# saying so); 1 anything else.
 set -euo pipefail
 
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
@@ -34,7 +35,7 @@ if [ ! -f "$PLATFORM/platform.json" ]; then
     exit 3
 fi
 for tool in avr-gcc avr-objcopy avr-size avrdude; do
-    command -v "$tool" >/dev/null || { say "$tool not found: run make system-deps as root"; exit 1; }
+    command -v "$tool" >/dev/null || { say "$tool not found: run make system-deps as root"; exit 3; }
 done
 [ -x "$VENV/bin/python" ] || { say "no virtual environment at $VENV: run make venv"; exit 1; }
 

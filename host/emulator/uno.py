@@ -14,7 +14,8 @@ from host.emulator import build
 from host.emulator.board import MotorPins, WallClock
 from host.errors import HostError
 
-# Debian's arduino-core-avr: optiboot 4.4, the bootloader Unos carry
+# Debian's arduino-core-avr: optiboot 4.4, the version Unos carry (Debian's build overruns the
+# 512-byte boot section; uno.c says how the simulated flash makes room)
 OPTIBOOT = Path("/usr/share/arduino/hardware/arduino/avr/bootloaders/optiboot/"
                 "optiboot_atmega328.hex")
 SOURCE = build.FIRMWARE / "simavr" / "uno.c"
