@@ -107,14 +107,18 @@ def _run_uno(args: argparse.Namespace) -> int:
         print(f"a simulated Arduino Uno (optiboot) on {uno.path}, flash in {args.flash}; "
               f"opening the port resets it (Ctrl-C to stop)", file=sys.stderr, flush=True)
         t_end = None if args.duration is None else time.monotonic() + args.duration
-        seen_resets, seen_saves, last = 0, 0, None
+        seen_resets, seen_saves, seen_crashes, last = 0, 0, 0, None
         with contextlib.suppress(KeyboardInterrupt):
             while t_end is None or time.monotonic() < t_end:
                 for r in uno.resets[seen_resets:]:
                     print(f"reset at {r.cycle / 16e6:8.3f} s ({r.flags})", file=sys.stderr)
+                for c in uno.crashes[seen_crashes:]:
+                    print(f"the program stopped the simulated CPU at {c / 16e6:8.3f} s; it "
+                          f"restarts at the next reset (open the port)", file=sys.stderr)
                 for n in uno.saves[seen_saves:]:
                     print(f"programmed: {n} bytes saved to {args.flash}", file=sys.stderr)
                 seen_resets, seen_saves = len(uno.resets), len(uno.saves)
+                seen_crashes = len(uno.crashes)
                 if uno.motors() != last:
                     last = uno.motors()
                     print(f"motors left {last[0]:5d} right {last[1]:5d} permille",

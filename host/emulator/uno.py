@@ -71,6 +71,7 @@ class SimulatedUno:
         self.flash = flash
         self.resets: list[Reset] = []
         self.saves: list[int] = []  # bytes programmed, at each save of the flash file
+        self.crashes: list[int] = []  # cycles at which simavr stopped the CPU (until a reset)
         self.pins = MotorPins()
         self._clock = WallClock()
         self._cond = threading.Condition()
@@ -97,6 +98,8 @@ class SimulatedUno:
                     self.pins.feed(line)
                 elif kind == "saved":
                     self.saves.append(int(rest[0]))
+                elif kind == "crashed":
+                    self.crashes.append(int(rest[0]))
                 self._cond.notify_all()
 
     def wait(self, condition: Callable[[SimulatedUno], bool], timeout_s: float) -> bool:

@@ -76,7 +76,11 @@ class RobotLink:
                                               write_timeout=1.0)
         except (serial.SerialException, OSError, ValueError) as e:
             raise LinkError(f"cannot open {self.port}: {_reason(e)}") from None
-        self.hello = self._handshake()
+        try:
+            self.hello = self._handshake()
+        except BaseException:
+            self.close()  # a failed handshake leaves the port closed (and an Uno's DTR off)
+            raise
         return self
 
     def _write(self, data: bytes) -> None:

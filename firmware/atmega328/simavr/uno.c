@@ -22,6 +22,7 @@
  *   reset CYCLE MCUSR           the chip reset (MCUSR as the bootloader sees it, hex)
  *   pwm CYCLE OCR1A OCR1B DIR   a motor output changed (DIR = PD4..PD7 as a 4-bit number)
  *   saved BYTES                 FLASH.bin was written (BYTES programmed, i.e. not 0xFF)
+ *   crashed CYCLE PC            simavr stopped the CPU (until the next reset)
  * CYCLE counts CPU cycles since power-on. */
 #define _GNU_SOURCE
 #include <errno.h>
@@ -61,6 +62,7 @@ static struct {
     avr_irq_t *uart_in;
     int xon, master, client; /* client: a program has the port open */
     int inotify, opens, autoreset; /* opens: the port's open file descriptions */
+    int halted;                    /* simavr stopped the CPU; the next reset restarts it */
     uint8_t queue[4096];     /* bytes from the port waiting for UART0: queue[head..tail) */
     size_t head, tail;
     avr_cycle_count_t next_in, elapsed; /* elapsed: cycles before the last reset */
@@ -178,6 +180,7 @@ static int load_bootloader(const char *path)
 static void reset(uint8_t mcusr)
 {
     avr_cycle_count_t before = u.avr->cycle;
+    u.halted = 0;
     avr_reset(u.avr);
     if (u.avr->cycle < before) /* simavr restarts its cycle count at a reset */
         u.elapsed += before;
@@ -206,15 +209,17 @@ static void watch_pins(void)
     printf("pwm %llu %u %u %u\n", (unsigned long long)now(), a, b, dir);
 }
 
-static int step(void)
+static void step(void)
 {
     avr_flashaddr_t pc = u.avr->pc;
     avr_cycle_count_t before = u.avr->cycle;
     int state = avr_run(u.avr);
     if (state == cpu_Done || state == cpu_Crashed) {
-        fprintf(stderr, "uno: the simulated CPU stopped (state %d) at pc 0x%04x\n", state,
-                u.avr->pc);
-        return -1;
+        /* simavr gives up on code a real chip would run on (a half-written application, say):
+         * the chip is dead to the world until a reset, as a hung Uno is */
+        printf("crashed %llu %04x\n", (unsigned long long)now(), u.avr->pc);
+        u.halted = 1;
+        return;
     }
     if (u.avr->cycle < before) /* simavr restarts its cycle count at a reset */
         u.elapsed += before;
@@ -227,7 +232,6 @@ static int step(void)
     }
     feed_uart();
     watch_pins();
-    return 0;
 }
 
 /* A program opened the port: DTR goes active, and the auto-reset circuit pulses RESET. */
@@ -316,9 +320,10 @@ static int run(void)
     while (!u.stop) {
         /* a tenth of a simulated millisecond, then wait for the wall clock to catch up */
         avr_cycle_count_t end = now() + F_CPU / 10000;
-        while (now() < end)
-            if (step() < 0)
-                return 1;
+        while (now() < end && !u.halted)
+            step();
+        if (u.halted) /* time goes on for a stopped chip */
+            u.elapsed += end - now();
         serve_port();
         fflush(stdout);
         double ahead = (double)now() / F_CPU - (wall() - t0);
