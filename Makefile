@@ -10,7 +10,7 @@ DATA ?= $(abspath ../shared/data)
 # tests and benchmarks find the Middlebury scenes through this variable
 export STEREO_SERVO_DATA ?= $(if $(wildcard $(DATA)/middlebury/index.json),$(DATA),)
 
-.PHONY: demo test lint bench venv system-deps browser-deps protocol firmware flash mutants clean
+.PHONY: demo test lint bench venv system-deps browser-deps platformio protocol firmware flash mutants clean
 
 $(BIN)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -26,6 +26,12 @@ system-deps:
 browser-deps:
 	@bash tools/browser-deps.sh
 
+# PlatformIO Core in .venv and its atmelavr platform from Debian and PyPI, under build/platformio
+# (tools/platformio-offline.sh); exit 3 = no ../shared/platformio here, and the tests skip
+PIO_CORE := $(abspath build/platformio)
+platformio: venv system-deps
+	@bash tools/platformio-offline.sh || [ $$? -eq 3 ]
+
 demo: venv
 	@mkdir -p $(OUT)
 	$(BIN)/host eval --picture $(OUT)
@@ -34,7 +40,7 @@ demo: venv
 	$(BIN)/host servo --sim --border clip --num-disp 48 --log $(OUT)/servo.csv --plot $(OUT)/servo.png
 	@echo "pictures: $(OUT)/motorcycle.png (disparity), $(OUT)/tuning.png (tuning), $(OUT)/servo.png (servo run)"
 
-test: venv system-deps browser-deps lint
+test: venv system-deps browser-deps platformio lint
 	$(BIN)/python -m pytest
 
 lint: venv
@@ -59,12 +65,21 @@ mutants: venv system-deps
 protocol: venv
 	$(BIN)/python tools/protogen.py
 
-# the robot's firmware (firmware/atmega328/Makefile); flash with PORT=/dev/ttyACM0
+# the robot's firmware (firmware/atmega328/Makefile); flash with PORT=/dev/ttyACM0.
+# PLATFORMIO=1 builds and uploads with PlatformIO instead (platformio.ini, env uno).
+ifeq ($(PLATFORMIO),1)
+firmware: platformio
+	PLATFORMIO_CORE_DIR=$(PIO_CORE) $(BIN)/pio run -e uno
+
+flash: platformio
+	PLATFORMIO_CORE_DIR=$(PIO_CORE) $(BIN)/pio run -e uno -t upload $(if $(PORT),--upload-port $(PORT))
+else
 firmware: system-deps
 	$(MAKE) -C firmware/atmega328
 
 flash: system-deps
 	$(MAKE) -C firmware/atmega328 flash
+endif
 
 clean:
-	rm -rf $(VENV) $(OUT) .pytest_cache
+	rm -rf $(VENV) $(OUT) .pytest_cache .pio build

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Install the Debian packages the firmware build and tests need, when missing and run as root.
 set -euo pipefail
-packages=(gcc make gcc-avr avr-libc binutils-avr simavr libsimavr-dev avrdude)
+packages=(gcc make gcc-avr avr-libc binutils-avr simavr libsimavr-dev avrdude
+          arduino-core-avr) # arduino-core-avr: the Uno's bootloader (optiboot) for the simulated Uno
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

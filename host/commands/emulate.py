@@ -19,6 +19,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("emulate", help="run the robot's firmware on a pseudo-terminal")
     p.add_argument("--simavr", action="store_true",
                    help="run the real AVR binary in simavr instead of the natively built core")
+    p.add_argument("--uno", action="store_true",
+                   help="a simulated Arduino Uno with its bootloader: program it with avrdude "
+                        "or platformio, then talk to the firmware it runs")
+    p.add_argument("--flash", type=Path, default=Path("uno-flash.bin"), metavar="FILE",
+                   help="--uno: the board's application flash, kept between runs "
+                        "(absent = an erased chip; default %(default)s)")
     p.add_argument("--drop", type=RATE, default=0.0, metavar="RATE",
                    help="drop this share of the bytes, both ways")
     p.add_argument("--corrupt", type=RATE, default=0.0, metavar="RATE",
@@ -40,8 +46,14 @@ def _interrupt(*_: object) -> None:
 
 def run(args: argparse.Namespace) -> int:
     signal.signal(signal.SIGTERM, _interrupt)  # kill ends it like Ctrl-C
+    if args.simavr and args.uno:
+        raise HostError("--simavr and --uno are two different boards: choose one")
+    if args.simavr or args.uno:
+        _no_faults(args)
     if args.simavr:
         return _run_simavr(args)
+    if args.uno:
+        return _run_uno(args)
     faults = Faults(args.drop, args.corrupt, args.delay_ms,
                     None if args.silent_after is None else args.silent_after * 1000, args.seed)
     emu = Emulator(faults)
@@ -61,12 +73,16 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _no_faults(args: argparse.Namespace) -> None:
+    if args.drop or args.corrupt or args.delay_ms or args.silent_after is not None:
+        raise HostError("fault injection works on the native emulator only "
+                        "(drop --simavr/--uno)")
+
+
 def _run_simavr(args: argparse.Namespace) -> int:
     from host.emulator import build
     from host.emulator.simavr import SimavrPty
 
-    if args.drop or args.corrupt or args.delay_ms or args.silent_after is not None:
-        raise HostError("fault injection works on the native emulator only (drop --simavr)")
     with tempfile.TemporaryDirectory() as d:
         harness = build.simavr_harness(Path(d))
         with SimavrPty(harness, build.firmware_elf()) as sim:
@@ -75,4 +91,34 @@ def _run_simavr(args: argparse.Namespace) -> int:
                   file=sys.stderr)
             with contextlib.suppress(KeyboardInterrupt):
                 time.sleep(args.duration if args.duration is not None else 1e9)
+    return 0
+
+
+def _run_uno(args: argparse.Namespace) -> int:
+    from host.emulator.uno import SimulatedUno
+
+    if args.flash.exists() and args.flash.is_dir():
+        raise HostError(f"--flash {args.flash} is a folder; name a file")
+    with SimulatedUno(args.flash) as uno:
+        print(uno.path, flush=True)
+        print(f"a simulated Arduino Uno (optiboot) on {uno.path}, flash in {args.flash}; "
+              f"opening the port resets it (Ctrl-C to stop)", file=sys.stderr, flush=True)
+        t_end = None if args.duration is None else time.monotonic() + args.duration
+        seen_resets, seen_saves, seen_crashes, last = 0, 0, 0, None
+        with contextlib.suppress(KeyboardInterrupt):
+            while t_end is None or time.monotonic() < t_end:
+                for r in uno.resets[seen_resets:]:
+                    print(f"reset at {r.cycle / 16e6:8.3f} s ({r.flags})", file=sys.stderr)
+                for c in uno.crashes[seen_crashes:]:
+                    print(f"the program stopped the simulated CPU at {c / 16e6:8.3f} s; it "
+                          f"restarts at the next reset (open the port)", file=sys.stderr)
+                for n in uno.saves[seen_saves:]:
+                    print(f"programmed: {n} bytes saved to {args.flash}", file=sys.stderr)
+                seen_resets, seen_saves = len(uno.resets), len(uno.saves)
+                seen_crashes = len(uno.crashes)
+                if uno.motors() != last:
+                    last = uno.motors()
+                    print(f"motors left {last[0]:5d} right {last[1]:5d} permille",
+                          file=sys.stderr, flush=True)
+                time.sleep(0.01)
     return 0

@@ -36,6 +36,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--sim", action="store_true",
                    help="simulated camera and world with the emulator on a pty")
     p.add_argument("--port", help="serial port of the robot, or 'emulator'")
+    p.add_argument("--robot", choices=("emulator", "simavr", "uno"), default="emulator",
+                   help="--sim: the robot in the simulated world: the firmware's core built "
+                        "natively (in lockstep), its AVR binary in simavr, or a simulated Uno "
+                        "running what was flashed into --flash (both in real time)")
+    p.add_argument("--flash", type=Path, default=Path("uno-flash.bin"), metavar="FILE",
+                   help="--robot uno: the board's flash, as `host emulate --uno --flash FILE` "
+                        "and an upload left it (default %(default)s)")
     p.add_argument("--log", type=Path, metavar="run.csv", help="write the run's log")
     p.add_argument("--plot", type=Path, metavar="run.png", help="plot trajectory and commands")
     p.add_argument("--duration", type=POSITIVE, metavar="S", help="stop after S seconds")
@@ -90,6 +97,9 @@ class _Status:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.robot != "emulator" and not args.sim:
+        raise HostError(f"--robot {args.robot} puts a simulated board in the simulated world: "
+                        f"it needs --sim")
     if args.log:
         check_output(args.log, "csv", "--log")
     if args.plot:
@@ -106,7 +116,9 @@ def run(args: argparse.Namespace) -> int:
     params = params_from_args(args)
     with contextlib.ExitStack() as stack:
         emulator, service = None, None
-        if args.port == "emulator":
+        if args.sim and args.robot != "emulator":
+            emulator = service = stack.enter_context(_avr_board(args))
+        elif args.port == "emulator":
             from host.emulator.emulator import Emulator, PtyService
 
             emulator = Emulator(line_rate=args.camera != "sim")
@@ -121,6 +133,25 @@ def run(args: argparse.Namespace) -> int:
             geometry = (Calibration.load(args.calib).geometry if args.calib
                         else Geometry.minoru_default(*parse_size(args.size)))
         return _servo(args, params, source, link, geometry, world, clock)
+
+
+def _avr_board(args):
+    """The real AVR firmware on a simulated board, for the simulated world to drive."""
+    from host.emulator import build
+
+    if args.robot == "uno":
+        from host.emulator.uno import SimulatedUno
+
+        if not args.flash.is_file():
+            raise HostError(f"--flash {args.flash} not found: flash the Uno first (host emulate "
+                            f"--uno --flash {args.flash}, then make flash PORT=...)")
+        return SimulatedUno(args.flash)
+    from host.emulator.simavr import SimavrPty
+
+    out = build.ROOT / "build" / "simavr"
+    out.mkdir(parents=True, exist_ok=True)
+    harness = build.simavr_harness(out)
+    return SimavrPty(harness, build.firmware_elf())
 
 
 def _sim(args, emulator):

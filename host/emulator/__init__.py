@@ -1,1 +1,2 @@
-"""Stand-ins for the robot: the firmware's own C core built natively, and the real ELF in simavr."""
+"""Stand-ins for the robot: the firmware's own C core built natively, the real ELF in simavr,
+and a simulated Uno that runs what was flashed through its bootloader (one Board interface)."""

@@ -6,9 +6,11 @@ from __future__ import annotations
 
 import random
 import subprocess
+import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from host.emulator.board import MotorPins, WallClock
 from host.emulator.pins import Io
 from host.link import protocol_gen as gen
 from host.link.frame import Frame, FrameDecoder, encode_frame
@@ -147,18 +149,38 @@ def run(harness: Path, elf: Path, script: Script, timeout: float = 120) -> SimRu
 
 
 class SimavrPty:
-    """The real ELF in simavr, in real time, its UART0 on a pseudo-terminal."""
+    """The real ELF in simavr, in real time, its UART0 on a pseudo-terminal; its motor pins are
+    read from the harness's events (a Board, like the native emulator and the simulated Uno)."""
 
     def __init__(self, harness: Path, elf: Path) -> None:
+        self.pins = MotorPins()
+        self._clock = WallClock()
         self._proc = subprocess.Popen([str(harness), str(elf), "--pty"], stdout=subprocess.PIPE,
-                                      stderr=subprocess.DEVNULL, text=True)
+                                      stderr=subprocess.PIPE, text=True)
         assert self._proc.stdout is not None
         for line in self._proc.stdout:  # simavr's own "Loaded ..." lines come first
             if line.startswith("pty "):
                 self.path = line.split()[1]
-                return
-        self.close()
-        raise RuntimeError("the simavr harness did not start")
+                break
+        else:
+            self.close()
+            raise RuntimeError("the simavr harness did not start")
+        self._reader = threading.Thread(target=self._read_events, daemon=True)
+        self._reader.start()
+
+    def _read_events(self) -> None:
+        assert self._proc.stderr is not None
+        for line in self._proc.stderr:  # pwm and reset events
+            if line.strip():
+                self.pins.feed(line)
+
+    def motors(self) -> tuple[int, int]:
+        """Duty (permille) the firmware applies, from OCR1A/OCR1B and PD4..PD7."""
+        return self.pins.motors()
+
+    def advance(self, ms: float) -> None:
+        """Let ms of the board's time pass (it runs on the wall clock, so this waits)."""
+        self._clock.advance(ms)
 
     def close(self) -> None:
         if self._proc.poll() is None:

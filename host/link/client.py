@@ -27,6 +27,26 @@ class LinkError(HostError):
     """The serial link or the robot failed; the message is one line."""
 
 
+_RESET_EXPLAINED = {
+    gen.ResetCause.WATCHDOG: "watchdog: the firmware hung; the watchdog stopped the motors and "
+                             "reset the board",
+    gen.ResetCause.POWER_ON: "power-on: the board lost its supply",
+    gen.ResetCause.EXTERNAL: "external: its reset pin (the reset button, or another program "
+                             "opening the port)",
+    gen.ResetCause.BROWN_OUT: "brown-out: its supply voltage dropped",
+    gen.ResetCause.UNKNOWN: "cause unknown (behind the Uno's bootloader: the reset pin or a "
+                            "brown-out that kept RAM)",
+}
+
+
+def explain_reset(cause: int) -> str:
+    """One phrase for a proto reset cause, naming it and what it means for the user."""
+    try:
+        return _RESET_EXPLAINED[gen.ResetCause(cause)]
+    except ValueError:
+        return f"cause {cause} (not in this host's protocol)"
+
+
 class RobotLink:
     """A session with the robot over a serial port (a device path or a pyserial URL)."""
 
@@ -64,7 +84,11 @@ class RobotLink:
                                               write_timeout=1.0)
         except (serial.SerialException, OSError, ValueError) as e:
             raise LinkError(f"cannot open {self.port}: {_reason(e)}") from None
-        self.hello = self._handshake()
+        try:
+            self.hello = self._handshake()
+        except BaseException:
+            self.close()  # a failed handshake leaves the port closed (and an Uno's DTR off)
+            raise
         return self
 
     def _write(self, data: bytes) -> None:
@@ -89,8 +113,8 @@ class RobotLink:
                 continue  # a frame from a robot of another spec; the handshake says so
             if isinstance(msg, gen.Boot) and self.hello is not None:
                 self.resets += 1
-                raise LinkError(f"the robot reset during the session (cause "
-                                f"{gen.ResetCause(msg.reset_cause).name.lower()})")
+                raise LinkError(f"the robot reset during the session: "
+                                f"{explain_reset(msg.reset_cause)}")
             out.append(msg)
         return out
 

@@ -91,11 +91,16 @@ def test_watchdog_resets_a_hung_firmware_with_the_motors_off(harness, hang_elf) 
     r = run(harness, hang_elf, s)
     assert len(r.resets) == 1
     hang_start = r.ins[3 * len(encode_frame(0, *pack(NO_RAMP))) - 1][0] + CYCLES_PER_BYTE
-    # WDTO_120MS is nominal; simavr times it at about 99 ms, the datasheet allows 0.8x-1.2x
+    # two WDTO_60MS periods (interrupt, then reset); simavr times one at 64 ms, the datasheet
+    # allows 0.8x-1.2x
     assert 80 <= (r.resets[0] - hang_start) / MS <= 150
-    driving = [p for p in r.settled() if p.cycle < r.resets[0]][-1]
-    after = [p for p in r.pwm if p.cycle >= r.resets[0]]
-    assert driving.ocr1a == 200 and after and all(p.ocr1a == p.ocr1b == 0 for p in after)
+    driving = [p for p in r.settled() if p.cycle < hang_start][-1]
+    stopped = next(p for p in r.settled() if p.cycle > hang_start)
+    # the watchdog interrupt stops the motors one period into the hang, before the reset
+    assert driving.ocr1a == 200 and (stopped.ocr1a, stopped.ocr1b, stopped.dir) == (0, 0, 0)
+    assert 40 <= (stopped.cycle - hang_start) / MS <= 80
+    after = [p for p in r.pwm if p.cycle >= stopped.cycle]
+    assert all(p.ocr1a == p.ocr1b == 0 for p in after)
     msgs = messages(r)
     boots = [m for m in msgs if isinstance(m, gen.Boot)]
     assert [b.reset_cause for b in boots] == [gen.ResetCause.POWER_ON, gen.ResetCause.WATCHDOG]

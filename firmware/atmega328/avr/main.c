@@ -34,7 +34,7 @@ int main(void)
     uart_init();
     sei();
     robot_init(reset_cause(), clock_ms());
-    wdt_enable(WDTO_120MS);
+    reset_watchdog_start();
     set_sleep_mode(SLEEP_MODE_IDLE);
     for (;;) {
         wdt_reset(); /* the one feed: a pass that never completes lets the watchdog bite */
