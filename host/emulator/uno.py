@@ -27,7 +27,7 @@ def program(out_dir: Path) -> Path:
     """Compile uno.c against libsimavr into out_dir (again when the source is newer)."""
     build._need("gcc", "gcc")
     if not (build.SIMAVR_INCLUDE / "sim_avr.h").exists():
-        raise HostError("simavr headers not found: install simavr and libsimavr-dev")
+        raise build.ToolMissing("simavr headers not found: install simavr and libsimavr-dev")
     exe = out_dir / "simavr-uno"
     if exe.exists() and exe.stat().st_mtime >= SOURCE.stat().st_mtime:
         return exe
@@ -37,7 +37,7 @@ def program(out_dir: Path) -> Path:
                         f"-I{build.SIMAVR_INCLUDE}", str(SOURCE), "-lsimavr", "-o", str(tmp)],
                        capture_output=True, text=True)
     if r.returncode:
-        raise RuntimeError(f"building the simulated Uno failed:\n{r.stderr}")
+        raise build.BuildFailed(f"building the simulated Uno failed:\n{r.stderr}")
     os.replace(tmp, exe)
     return exe
 
@@ -65,7 +65,7 @@ class SimulatedUno:
     def __init__(self, flash: Path, out_dir: Path = build.ROOT / "build" / "simavr",
                  bootloader: Path | None = OPTIBOOT, autoreset: bool = True) -> None:
         if bootloader is not None and not bootloader.exists():
-            raise HostError(f"the Uno's bootloader {bootloader} is missing: install "
+            raise build.ToolMissing(f"the Uno's bootloader {bootloader} is missing: install "
                             "arduino-core-avr (make system-deps, as root)")
         exe = program(out_dir)
         self.flash = flash

@@ -12,7 +12,6 @@ import pytest
 
 from host.emulator import build
 from host.emulator.uno import SimulatedUno, hex_image
-from host.errors import HostError
 from host.link import protocol_gen as gen
 from host.link.client import RobotLink
 
@@ -68,7 +67,7 @@ def test_platformio_run_builds_every_environment(built) -> None:
 def test_the_uno_image_is_the_makefiles(built) -> None:
     try:
         make_elf = build.firmware_elf()
-    except HostError as e:
+    except build.ToolMissing as e:
         pytest.skip(str(e))
     # the same functions and sizes; link-time optimisation may lay them out in another order
     assert _sizes(built / "uno" / "firmware.elf") == _sizes(make_elf)
@@ -79,7 +78,7 @@ def test_platformio_upload_programs_the_simulated_uno_and_the_firmware_says_hell
     image = hex_image(built / "uno" / "firmware.hex")
     try:
         uno = SimulatedUno(tmp_path / "flash.bin")
-    except HostError as e:
+    except build.ToolMissing as e:
         pytest.skip(str(e))
     with uno:
         r = _pio(pio_env, "run", "-e", "uno", "-t", "upload", "--upload-port", uno.path)

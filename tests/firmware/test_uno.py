@@ -15,7 +15,6 @@ import pytest
 from host.emulator import build
 from host.emulator.emulator import Emulator, PtyService
 from host.emulator.uno import F_CPU, SimulatedUno, avrdude, hex_image
-from host.errors import HostError
 from host.link import protocol_gen as gen
 from host.link.client import LinkError, RobotLink
 from host.link.frame import encode_frame
@@ -29,7 +28,7 @@ def _hex(test_hang: bool = False) -> Path:
     try:
         elf = build.firmware_elf(test_hang)
         build._need("avrdude", "avrdude")
-    except HostError as e:
+    except build.ToolMissing as e:
         pytest.skip(str(e))
     return elf.with_suffix(".hex")
 
@@ -39,7 +38,7 @@ def _board(flash: Path, image: Path | None = None, **kw) -> SimulatedUno:
         shutil.copy(image, flash)
     try:
         return SimulatedUno(flash, **kw)
-    except HostError as e:  # the bootloader or simavr is not installed; build errors raise
+    except build.ToolMissing as e:  # the bootloader or simavr is not installed; build errors fail
         pytest.skip(str(e))
 
 
@@ -215,7 +214,7 @@ def test_the_avr_boards_show_the_motor_duty_the_firmware_applies(robot, flashed,
         try:
             harness = build.simavr_harness(tmp_path)
             elf = build.firmware_elf()
-        except HostError as e:
+        except build.ToolMissing as e:
             pytest.skip(str(e))
         board = SimavrPty(harness, elf)
     with board, RobotLink(board.path) as robot_link:
