@@ -72,6 +72,7 @@ def _assert_image(flash: Path, hex_file: Path) -> None:
 def _works(port: str) -> None:
     with RobotLink(port, handshake_s=5) as robot:
         assert robot.hello.schema_hash == gen.SCHEMA_HASH
+        robot.set_config(gen.DEFAULT_LINK_TIMEOUT_MS, accel_limit=0)  # unramped, to read back
         robot.drive(250, -250)
         assert (robot.status().left, robot.status().right) == (250, -250)
 
