@@ -3,14 +3,17 @@
 from __future__ import annotations
 
 import cv2
+import numba
 import numpy as np
 
 from host.errors import HostError
 from host.stereo import block_matching as bm
+from host.stereo import sad
 from host.stereo.grey import to_grey
 from host.stereo.opencv_backend import opencv_disparity
 from host.stereo.params import MatcherParams
 from host.stereo.postprocess import fill_background, lr_consistency, median
+from host.stereo.subpixel import DEFAULT_FITS, FIT_NONE, FITS
 
 
 def _box_sums(img: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray]:
@@ -34,6 +37,8 @@ def own_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
 
     SAD and SSD sum the cost over the colour channels when p.colour is set; NCC uses grey.
     """
+    if p.matcher == "sad":
+        return sad_disparity(left, right, p)
     kind = bm.COSTS[p.matcher]
     colour = p.colour and kind != bm.COST_NCC
     pl, pr = _planes(left, colour), _planes(right, colour)
@@ -48,6 +53,28 @@ def own_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
                                    p.block_size // 2, kind, float(p.uniqueness_ratio),
                                    p.subpixel, want_right, p.border == "clip",
                                    sl, ql, sr, qr)
+    if want_right:
+        disp_l = lr_consistency(disp_l, disp_r, float(p.lr_check))
+    return disp_l
+
+
+def subpixel_fit(p: MatcherParams) -> int:
+    """The sub-pixel fit p asks for: none, its own choice, or the measured default for its cost."""
+    if not p.subpixel:
+        return FIT_NONE
+    return FITS[DEFAULT_FITS[p.matcher] if p.subpixel_fit == "auto" else p.subpixel_fit]
+
+
+def sad_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.ndarray:
+    """The own SAD matcher (host/stereo/sad.py), summed over colour channels if p.colour."""
+    pl, pr = _planes(left, p.colour), _planes(right, p.colour)
+    cdt, wdt = sad.lane_types(pl.shape[0], p.block_size)
+    want_right = p.lr_check is not None
+    disp_l, disp_r = sad.match_sad(pl, pr, p.min_disparity, p.num_disparities,
+                                   p.block_size // 2, float(p.uniqueness_ratio),
+                                   subpixel_fit(p), want_right, p.border == "clip",
+                                   np.empty(0, cdt), np.empty(0, wdt), np.iinfo(wdt).max,
+                                    numba.get_num_threads())
     if want_right:
         disp_l = lr_consistency(disp_l, disp_r, float(p.lr_check))
     return disp_l
