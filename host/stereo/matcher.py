@@ -8,12 +8,15 @@ import numpy as np
 
 from host.errors import HostError
 from host.stereo import block_matching as bm
-from host.stereo import sad
+from host.stereo import sad, sgm
 from host.stereo.grey import to_grey
 from host.stereo.opencv_backend import opencv_disparity
 from host.stereo.params import MatcherParams
 from host.stereo.postprocess import fill_background, lr_consistency, median
 from host.stereo.subpixel import DEFAULT_FITS, FIT_NONE, FITS
+
+SGM_P1 = 8  # default SGM penalties per pixel of the cost box (census bits)
+SGM_P2 = 32
 
 
 def _box_sums(img: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray]:
@@ -39,6 +42,8 @@ def own_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
     """
     if p.matcher == "sad":
         return sad_disparity(left, right, p)
+    if p.matcher == "sgm":
+        return sgm_disparity(left, right, p)
     kind = bm.COSTS[p.matcher]
     colour = p.colour and kind != bm.COST_NCC
     pl, pr = _planes(left, colour), _planes(right, colour)
@@ -77,6 +82,36 @@ def sad_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
                                     numba.get_num_threads())
     if want_right:
         disp_l = lr_consistency(disp_l, disp_r, float(p.lr_check))
+    return disp_l
+
+
+def sgm_penalties(p: MatcherParams) -> tuple[int, int]:
+    """(P1, P2) for the own SGM: p.p1 / p.p2 when set, else defaults per box-summed census."""
+    area = p.block_size ** 2
+    p1 = p.p1 or SGM_P1 * area
+    return p1, max(p.p2 or SGM_P2 * area, p1)
+
+
+def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.ndarray:
+    """The own census + semi-global matcher (host/stereo/sgm.py) on grey."""
+    gl, gr = to_grey(left), to_grey(right)
+    census = [sgm.census(cv2.copyMakeBorder(g, sgm.CENSUS_H, sgm.CENSUS_H, sgm.CENSUS_W,
+                                            sgm.CENSUS_W, cv2.BORDER_REPLICATE)) for g in (gl, gr)]
+    cost = sgm.hamming_volume(census[0], census[1], p.min_disparity, p.num_disparities)
+    if p.block_size > 1:
+        cost = sgm.box_sum(cost, p.block_size)
+    p1, p2 = sgm_penalties(p)
+    sums = sgm.aggregate(cost, np.uint16(p1), np.uint16(p2))
+    want_right = p.lr_check is not None
+    disp_l, disp_r = sgm.decide(sums, p.min_disparity, float(p.uniqueness_ratio),
+                                subpixel_fit(p), want_right)
+    if want_right:
+        disp_l = lr_consistency(disp_l, disp_r, float(p.lr_check))
+    if p.border == "invalid":
+        # the census (and box) window of these pixels leaves the image
+        ry, rx = sgm.CENSUS_H + p.block_size // 2, sgm.CENSUS_W + p.block_size // 2
+        disp_l[:ry] = disp_l[-ry:] = np.nan
+        disp_l[:, :rx] = disp_l[:, -rx:] = np.nan
     return disp_l
 
 

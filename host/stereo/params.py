@@ -7,7 +7,7 @@ from typing import Any
 
 from host.errors import HostError
 
-MATCHERS = ("sad", "ssd", "ncc", "opencv-bm", "opencv-sgbm")
+MATCHERS = ("sad", "ssd", "ncc", "sgm", "opencv-bm", "opencv-sgbm")
 BORDERS = ("invalid", "clip")
 SUBPIXEL_FITS = ("auto", "parabola", "equiangular")
 SGBM_MODES = {"sgbm": 0, "hh": 1, "sgbm3way": 2, "hh4": 3}

@@ -15,7 +15,7 @@ FIT_PARABOLA = 1
 FIT_EQUIANGULAR = 2
 FITS = {"parabola": FIT_PARABOLA, "equiangular": FIT_EQUIANGULAR}
 # the fit each own matcher uses when none is asked for (measured: docs/stereo.md, Sub-pixel)
-DEFAULT_FITS = {"sad": "equiangular", "ssd": "parabola", "ncc": "parabola"}
+DEFAULT_FITS = {"sad": "equiangular", "ssd": "parabola", "ncc": "parabola", "sgm": "equiangular"}
 
 
 @njit(cache=True, fastmath=True, inline="always")
