@@ -9,10 +9,13 @@ import time
 from pathlib import Path
 from typing import Any
 
+import cv2
+import numba
+
 from host.commands.options import add_matcher_options, num_disp_given, params_from_args
 from host.errors import HostError
 from host.files import write_image_atomic
-from host.stereo.matcher import compute_disparity, warm_up
+from host.stereo.matcher import compute_disparity, matched_on, warm_up
 from host.stereo.metrics import evaluate
 from host.stereo.params import MatcherParams
 from host.stereo.picture import colourise
@@ -34,7 +37,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def score_scene(scene: Scene, params: MatcherParams, rho: float) -> dict[str, Any]:
-    """One row of the table: bad (all GT-known), bad_nonocc, rms, density (%), ms."""
+    """One row of the table: bad (all GT-known), bad_nonocc, rms, density (%), ms (one
+    compute_disparity call after warm-up) and what it matched on (colour or grey)."""
     warm_up(params)
     t0 = time.perf_counter()
     disp = compute_disparity(scene.left, scene.right, params)
@@ -44,7 +48,8 @@ def score_scene(scene: Scene, params: MatcherParams, rho: float) -> dict[str, An
     nonocc = scene.masks.get("nonocc")
     bad_nonocc = evaluate(disp, scene.gt, nonocc, rho).bad if nonocc is not None else None
     return {"scene": scene.name, "bad": whole.bad, "bad_nonocc": bad_nonocc, "rms": whole.rms,
-            "density": whole.density, "ms": ms, "disp": disp}
+            "density": whole.density, "ms": ms, "ms_input": matched_on(scene.left, params),
+            "disp": disp}
 
 
 def _fmt(v: float | None, spec: str = ".2f") -> str:
@@ -76,4 +81,7 @@ def run(args: argparse.Namespace) -> int:
     for r in out:
         print(f"{r['scene']:<16}{_fmt(r['bad']):>8}{_fmt(r['bad_nonocc']):>9}"
               f"{_fmt(r['rms']):>8}{_fmt(r['density']):>10}{_fmt(r['ms'], '.1f'):>9}")
+    inputs = sorted({r["ms_input"] for r in out})
+    print(f"ms: one compute_disparity call on the {'/'.join(inputs)} pair after warm-up, "
+          f"{numba.get_num_threads()} numba / {cv2.getNumThreads()} OpenCV threads")
     return 0

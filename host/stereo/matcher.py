@@ -132,6 +132,12 @@ def compute_disparity(left: np.ndarray, right: np.ndarray, params: MatcherParams
     return disp
 
 
+def matched_on(image: np.ndarray, p: MatcherParams) -> str:
+    """"colour" when the matcher p names matches on image's BGR channels, else "grey"."""
+    colour = p.matcher in ("sad", "ssd", "opencv-sgbm") and p.colour
+    return "colour" if colour and image.ndim == 3 and image.shape[2] >= 3 else "grey"
+
+
 def warm_up(params: MatcherParams) -> None:
     """Compile (or load from numba's cache) the kernels params needs, so timings exclude it."""
     rng = np.random.default_rng(0)
