@@ -38,7 +38,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 def score_scene(scene: Scene, params: MatcherParams, rho: float) -> dict[str, Any]:
     """One row of the table: bad (all GT-known), bad_nonocc, rms, density (%), ms (one
-    compute_disparity call after warm-up) and what it matched on (colour or grey)."""
+    compute_disparity call after warm-up)."""
     warm_up(params)
     t0 = time.perf_counter()
     disp = compute_disparity(scene.left, scene.right, params)
@@ -48,8 +48,7 @@ def score_scene(scene: Scene, params: MatcherParams, rho: float) -> dict[str, An
     nonocc = scene.masks.get("nonocc")
     bad_nonocc = evaluate(disp, scene.gt, nonocc, rho).bad if nonocc is not None else None
     return {"scene": scene.name, "bad": whole.bad, "bad_nonocc": bad_nonocc, "rms": whole.rms,
-            "density": whole.density, "ms": ms, "ms_input": matched_on(scene.left, params),
-            "disp": disp}
+            "density": whole.density, "ms": ms, "disp": disp}
 
 
 def _fmt(v: float | None, spec: str = ".2f") -> str:
@@ -81,7 +80,7 @@ def run(args: argparse.Namespace) -> int:
     for r in out:
         print(f"{r['scene']:<16}{_fmt(r['bad']):>8}{_fmt(r['bad_nonocc']):>9}"
               f"{_fmt(r['rms']):>8}{_fmt(r['density']):>10}{_fmt(r['ms'], '.1f'):>9}")
-    inputs = sorted({r["ms_input"] for r in out})
+    inputs = sorted({matched_on(s.left, params) for s in scenes})
     print(f"ms: one compute_disparity call on the {'/'.join(inputs)} pair after warm-up, "
           f"{numba.get_num_threads()} numba / {cv2.getNumThreads()} OpenCV threads")
     return 0
