@@ -57,10 +57,11 @@ def census(img):
 
 
 @njit(cache=True, parallel=True)
-def hamming_volume(cl, cr, dmin, nd):
-    """Cost volume (rows, cols, nd) uint16: census Hamming distance of x and x - dmin - j."""
+def hamming_volume(cl, cr, dmin, out):
+    """Fill out (rows, cols, nd) uint16 with the census Hamming distance of x and x - dmin - j.
+    """
     h, w = cl.shape
-    out = np.empty((h, w, nd), dtype=np.uint16)
+    nd = out.shape[2]
     far = np.uint16(CENSUS_BITS)
     for y in prange(h):
         lrow = cl[y]
@@ -155,10 +156,8 @@ def _pass(cost, total, forward, p1, p2):
 
 
 @njit(cache=True, parallel=True)
-def aggregate(cost, p1, p2):
-    """Sums over 8 paths, as two volumes (forward, backward) computed in parallel."""
-    h, w, nd = cost.shape
-    sums = np.empty((2, h, w, nd), dtype=np.uint16)
+def aggregate(cost, sums, p1, p2):
+    """Fill sums (2, rows, cols, nd) with the forward and backward 4-path sums, in parallel."""
     for k in prange(2):
         _pass(cost, sums[k], k == 0, p1, p2)
     return sums
@@ -183,8 +182,8 @@ def _wta(s, idx, n, uniqueness, fit):
                 return -1, 0.0
     off = 0.0
     if fit != FIT_NONE and 0 < best < n - 1:
-        # candidates ascend in d here, so the offset toward j - 1 is toward smaller d
-        off = -fit_offset(np.float32(s[best - 1]), c0, np.float32(s[best + 1]), fit)
+        # candidates ascend in d here: the minimum lies at best + offset
+        off = fit_offset(np.float32(s[best - 1]), c0, np.float32(s[best + 1]), fit)
     return best, off
 
 
@@ -202,7 +201,7 @@ def decide(sums, dmin, uniqueness, fit, want_right):
                 s[j] = sums[0, y, x, j] + sums[1, y, x, j]
             best, off = _wta(s, idx, nd, uniqueness, fit)
             if best >= 0:
-                disp_l[y, x] = dmin + best - off
+                disp_l[y, x] = dmin + best + off
         if want_right:
             for xr in range(w):
                 n = 0
@@ -215,5 +214,5 @@ def decide(sums, dmin, uniqueness, fit, want_right):
                 if n == 0:
                     continue
                 best, off = _wta(s, idx, n, 0.0, fit)
-                disp_r[y, xr] = dmin + best - off
+                disp_r[y, xr] = dmin + best + off
     return disp_l, disp_r

@@ -68,7 +68,8 @@ def _naive_paths(cost: np.ndarray, p1: int, p2: int) -> np.ndarray:
 def test_eight_path_aggregation_equals_the_plain_recurrence() -> None:
     rng = np.random.default_rng(4)
     cost = rng.integers(0, 63, (6, 7, 5)).astype(np.uint16)
-    sums = sgm.aggregate(cost, np.uint16(7), np.uint16(30))
+    sums = np.empty((2, *cost.shape), np.uint16)
+    sgm.aggregate(cost, sums, np.uint16(7), np.uint16(30))
     got = sums[0].astype(np.int64) + sums[1]
     np.testing.assert_array_equal(got, _naive_paths(cost, 7, 30))
 
