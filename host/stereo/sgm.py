@@ -189,30 +189,33 @@ def _wta(s, idx, n, uniqueness, fit):
 
 @njit(cache=True, parallel=True, fastmath=True)
 def decide(sums, dmin, uniqueness, fit, want_right):
-    """Left (and right) disparity maps in px, NaN where the uniqueness test rejects."""
+    """Left (and right) disparity maps in px, NaN where the uniqueness test rejects.
+
+    Each row's total (forward + backward) is formed once in a row buffer; the right view's
+    candidates are that buffer's diagonals (right pixel xr at disparity d is left x = xr + d).
+    """
     _, h, w, nd = sums.shape
     disp_l = np.full((h, w), np.nan, dtype=np.float32)
     disp_r = np.full((h, w), np.nan, dtype=np.float32)
     for y in prange(h):
+        row = np.empty((w, nd), dtype=np.uint16)
         s = np.empty(nd, dtype=np.uint16)
         idx = np.arange(nd + 1).astype(np.uint16)
         for x in range(w):
             for j in range(nd):
-                s[j] = sums[0, y, x, j] + sums[1, y, x, j]
+                row[x, j] = sums[0, y, x, j] + sums[1, y, x, j]
+            for j in range(nd):
+                s[j] = row[x, j]
             best, off = _wta(s, idx, nd, uniqueness, fit)
             if best >= 0:
                 disp_l[y, x] = dmin + best + off
         if want_right:
             for xr in range(w):
-                n = 0
-                for j in range(nd):
-                    x = xr + dmin + j
-                    if x >= w:
-                        break
-                    s[j] = sums[0, y, x, j] + sums[1, y, x, j]
-                    n += 1
-                if n == 0:
+                n = min(nd, w - xr - dmin)
+                if n <= 0:
                     continue
+                for j in range(n):
+                    s[j] = row[xr + dmin + j, j]
                 best, off = _wta(s, idx, n, 0.0, fit)
                 disp_r[y, xr] = dmin + best + off
     return disp_l, disp_r
