@@ -123,7 +123,7 @@ def test_sgm_border_invalid_leaves_the_census_margin_empty() -> None:
     assert np.isfinite(disp[sgm.CENSUS_H:-sgm.CENSUS_H, 48:-sgm.CENSUS_W]).mean() > 0.95
 
 
-# measured (docs/stereo.md): own SGM + LR 1 + fill, Cones 4.33 / 12.47, Teddy 7.62 / 15.90
+# measured (docs/stereo.md): own SGM + LR 1 + fill, Cones 4.35 / 12.47, Teddy 7.60 / 15.86
 # (nonocc / all, rho 1); OpenCV SGBM 3WAY grey, same post-processing: 5.91 / 13.53, 10.74 / 18.86
 LIMITS = {"cones": (5.0, 13.3), "teddy": (8.5, 17.0)}
 
