@@ -9,6 +9,9 @@ import time
 from pathlib import Path
 from typing import Any
 
+import cv2
+import numba
+
 from host.commands.options import (
     POSITIVE,
     add_matcher_options,
@@ -25,7 +28,7 @@ from host.files import (
     safe_name,
     write_image_atomic,
 )
-from host.stereo.matcher import compute_disparity, warm_up
+from host.stereo.matcher import compute_disparity, matched_on, warm_up
 from host.stereo.metrics import evaluate
 from host.stereo.params import MatcherParams
 from host.stereo.picture import picture
@@ -47,7 +50,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def score_scene(scene: Scene, params: MatcherParams, rho: float) -> dict[str, Any]:
-    """One row of the table: bad (all GT-known), bad_nonocc, rms, density (%), ms."""
+    """One row of the table: bad (all GT-known), bad_nonocc, rms, density (%), ms (one
+    compute_disparity call after warm-up)."""
     warm_up(params)
     t0 = time.perf_counter()
     disp = compute_disparity(scene.left, scene.right, params)
@@ -84,6 +88,9 @@ def run(args: argparse.Namespace) -> int:
     for r in out:
         print(f"{r['scene']:<16}{_fmt(r['bad']):>8}{_fmt(r['bad_nonocc']):>9}"
               f"{_fmt(r['rms']):>8}{_fmt(r['density']):>10}{_fmt(r['ms'], '.1f'):>9}")
+    inputs = sorted({matched_on(s.left, params) for s in scenes})
+    print(f"ms: one compute_disparity call on the {'/'.join(inputs)} pair after warm-up, "
+          f"{numba.get_num_threads()} numba / {cv2.getNumThreads()} OpenCV threads")
     return 0
 
 

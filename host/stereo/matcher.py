@@ -2,15 +2,23 @@
 
 from __future__ import annotations
 
+import threading
+
 import cv2
+import numba
 import numpy as np
 
 from host.errors import HostError
 from host.stereo import block_matching as bm
+from host.stereo import sad, sgm
 from host.stereo.grey import to_grey
 from host.stereo.opencv_backend import opencv_disparity
 from host.stereo.params import MatcherParams
 from host.stereo.postprocess import fill_background, lr_consistency, median
+from host.stereo.subpixel import DEFAULT_FITS, FIT_NONE, FITS
+
+SGM_P1 = 8  # default SGM penalties per pixel of the cost box (census bits)
+SGM_P2 = 32
 
 
 def _box_sums(img: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray]:
@@ -34,6 +42,10 @@ def own_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
 
     SAD and SSD sum the cost over the colour channels when p.colour is set; NCC uses grey.
     """
+    if p.matcher == "sad":
+        return sad_disparity(left, right, p)
+    if p.matcher == "sgm":
+        return sgm_disparity(left, right, p)
     kind = bm.COSTS[p.matcher]
     colour = p.colour and kind != bm.COST_NCC
     pl, pr = _planes(left, colour), _planes(right, colour)
@@ -53,6 +65,76 @@ def own_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
     return disp_l
 
 
+def subpixel_fit(p: MatcherParams) -> int:
+    """The sub-pixel fit p asks for: none, its own choice, or the measured default for its cost."""
+    if not p.subpixel:
+        return FIT_NONE
+    return FITS[DEFAULT_FITS[p.matcher] if p.subpixel_fit == "auto" else p.subpixel_fit]
+
+
+def sad_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.ndarray:
+    """The own SAD matcher (host/stereo/sad.py), summed over colour channels if p.colour."""
+    pl, pr = _planes(left, p.colour), _planes(right, p.colour)
+    cdt, wdt = sad.lane_types(pl.shape[0], p.block_size)
+    want_right = p.lr_check is not None
+    disp_l, disp_r = sad.match_sad(pl, pr, p.min_disparity, p.num_disparities,
+                                   p.block_size // 2, float(p.uniqueness_ratio),
+                                   subpixel_fit(p), want_right, p.border == "clip",
+                                   np.empty(0, cdt), np.empty(0, wdt), np.iinfo(wdt).max,
+                                    numba.get_num_threads())
+    if want_right:
+        disp_l = lr_consistency(disp_l, disp_r, float(p.lr_check))
+    return disp_l
+
+
+def sgm_penalties(p: MatcherParams) -> tuple[int, int]:
+    """(P1, P2) for the own SGM: p.p1 / p.p2 when set, else defaults per box-summed census."""
+    area = p.block_size ** 2
+    p1 = p.p1 or SGM_P1 * area
+    return p1, max(p.p2 or SGM_P2 * area, p1)
+
+
+_VOLUMES = threading.local()
+KEEP_BYTES = 256 << 20  # volumes up to this size are kept for the next call of the same size
+
+
+def _sgm_volumes(shape: tuple[int, ...], nd: int) -> tuple[np.ndarray, np.ndarray]:
+    """Cost and sum volumes for SGM, reused by the next call on the same size in this thread:
+    a fresh 100 MB costs ~15 ms of page faults per call at 640x480 / 64."""
+    key = (shape[0], shape[1], nd)
+    kept = getattr(_VOLUMES, "kept", None)
+    if kept is not None and kept[0] == key:
+        return kept[1], kept[2]
+    cost = np.empty(key, dtype=np.uint16)
+    sums = np.empty((2, *key), dtype=np.uint16)
+    _VOLUMES.kept = (key, cost, sums) if 3 * cost.nbytes <= KEEP_BYTES else None
+    return cost, sums
+
+
+def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.ndarray:
+    """The own census + semi-global matcher (host/stereo/sgm.py) on grey."""
+    gl, gr = to_grey(left), to_grey(right)
+    census = [sgm.census(cv2.copyMakeBorder(g, sgm.CENSUS_H, sgm.CENSUS_H, sgm.CENSUS_W,
+                                            sgm.CENSUS_W, cv2.BORDER_REPLICATE)) for g in (gl, gr)]
+    cost, sums = _sgm_volumes(gl.shape, p.num_disparities)
+    sgm.hamming_volume(census[0], census[1], p.min_disparity, cost)
+    if p.block_size > 1:
+        cost = sgm.box_sum(cost, p.block_size)
+    p1, p2 = sgm_penalties(p)
+    sgm.aggregate(cost, sums, np.uint16(p1), np.uint16(p2))
+    want_right = p.lr_check is not None
+    disp_l, disp_r = sgm.decide(sums, p.min_disparity, float(p.uniqueness_ratio),
+                                subpixel_fit(p), want_right)
+    if want_right:
+        disp_l = lr_consistency(disp_l, disp_r, float(p.lr_check))
+    if p.border == "invalid":
+        # the census (and box) window of these pixels leaves the image
+        ry, rx = sgm.CENSUS_H + p.block_size // 2, sgm.CENSUS_W + p.block_size // 2
+        disp_l[:ry] = disp_l[-ry:] = np.nan
+        disp_l[:, :rx] = disp_l[:, -rx:] = np.nan
+    return disp_l
+
+
 def compute_disparity(left: np.ndarray, right: np.ndarray, params: MatcherParams) -> np.ndarray:
     """Disparity of the left view in px, float32, NaN = invalid. Colour input is converted."""
     if left.shape[:2] != right.shape[:2]:
@@ -68,6 +150,12 @@ def compute_disparity(left: np.ndarray, right: np.ndarray, params: MatcherParams
     if p.median:
         disp = median(disp, p.median)
     return disp
+
+
+def matched_on(image: np.ndarray, p: MatcherParams) -> str:
+    """"colour" when the matcher p names matches on image's BGR channels, else "grey"."""
+    colour = p.matcher in ("sad", "ssd", "opencv-sgbm") and p.colour
+    return "colour" if colour and image.ndim == 3 and image.shape[2] >= 3 else "grey"
 
 
 def warm_up(params: MatcherParams) -> None:

@@ -7,8 +7,9 @@ from typing import Any
 
 from host.errors import HostError
 
-MATCHERS = ("sad", "ssd", "ncc", "opencv-bm", "opencv-sgbm")
+MATCHERS = ("sad", "ssd", "ncc", "sgm", "opencv-bm", "opencv-sgbm")
 BORDERS = ("invalid", "clip")
+SUBPIXEL_FITS = ("auto", "parabola", "equiangular")
 SGBM_MODES = {"sgbm": 0, "hh": 1, "sgbm3way": 2, "hh4": 3}
 
 
@@ -17,7 +18,8 @@ class MatcherParams:
     """Block-matching parameters; names follow OpenCV's (blockSize -> block_size ...).
 
     Units: block_size, num_disparities, min_disparity, lr_check and speckle_range in pixels;
-    uniqueness_ratio in percent (0 = off); lr_check None = off; colour = match on the BGR
+    uniqueness_ratio in percent (0 = off); subpixel_fit = "parabola", "equiangular" or "auto"
+    (the measured best for the matcher's cost); lr_check None = off; colour = match on the BGR
     channels where the input has them (SAD, SSD, SGBM), else on grey; border = "invalid"
     (a pixel whose window leaves the image has no disparity) or "clip" (the window is cropped
     to the image; own matchers only); median = median-filter size
@@ -29,6 +31,7 @@ class MatcherParams:
     num_disparities: int = 64
     min_disparity: int = 0
     subpixel: bool = True
+    subpixel_fit: str = "auto"
     colour: bool = True
     border: str = "invalid"
     lr_check: float | None = None
@@ -89,6 +92,9 @@ class MatcherParams:
             raise HostError(f"min-disp must be >= 0 for {self.matcher}, got {self.min_disparity}")
         if self.median not in (0, 3, 5):
             raise HostError(f"median must be 0, 3 or 5, got {self.median}")
+        if self.subpixel_fit not in SUBPIXEL_FITS:
+            raise HostError(f"unknown sub-pixel fit {self.subpixel_fit!r} "
+                            f"(choose from {', '.join(SUBPIXEL_FITS)})")
         if self.mode not in SGBM_MODES:
             raise HostError(f"unknown SGBM mode {self.mode!r} "
                             f"(choose from {', '.join(SGBM_MODES)})")

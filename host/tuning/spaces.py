@@ -46,7 +46,8 @@ class Space:
         v = self.values(state)
         p1, p2 = v.pop("p1_factor", None), v.pop("p2_factor", None)
         params = self.base.replace(**v)
-        area = 3 * params.block_size ** 2
+        # OpenCV's penalties scale with the matched channels: 3 for colour, 1 for grey
+        area = (3 if params.colour else 1) * params.block_size ** 2
         if p1 is not None:
             params = params.replace(p1=int(p1 * area))
         if p2 is not None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import cv2
@@ -88,10 +89,16 @@ def test_default_scene_is_motorcycle_with_ground_truth() -> None:
 
 
 def test_shared_middlebury_scenes(middlebury: Path) -> None:
-    scenes = load_scenes([middlebury])
-    assert [s.name for s in scenes] == ["cones", "teddy"]
-    for s in scenes:
-        assert s.left.shape[:2] == (375, 450) and s.gt is not None
+    index = json.loads((middlebury / "index.json").read_text())["scenes"]
+    scenes = {s.name: s for s in load_scenes([middlebury])}
+    assert sorted(scenes) == sorted(e["scene"] for e in index)
+    for e in index:
+        s = scenes[e["scene"]]
+        assert s.left.shape[:2] == (e["height"], e["width"]) and s.gt is not None
+        assert {"nonocc", "all"} <= set(s.masks)
+        assert s.masks["nonocc"].sum() < s.masks["all"].sum()
+    for name in ("cones", "teddy"):
+        s = scenes[name]
+        assert s.left.shape[:2] == (375, 450)
         assert 50 < np.nanmax(s.gt) <= 55
         assert set(s.masks) == {"nonocc", "all", "disc"}
-        assert s.masks["nonocc"].sum() < s.masks["all"].sum()

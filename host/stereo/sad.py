@@ -1,0 +1,263 @@
+"""Own SAD block matcher: banded, row-tiled running sums in narrow integer lanes, WTA, sub-pixel.
+
+Conventions as in block_matching: the left image is the reference, left x matches right x - d,
+output is float32 px with NaN where there is no disparity. Candidate k of pixel x is disparity
+dmin + nd - 1 - k, so the right pixels of one x form a contiguous run and the k loops vectorise.
+
+Work per pixel and candidate: one column-sum update (a row enters, a row leaves) and one window
+slide (a column enters, a column leaves) fused with the minimum. The image is cut into one band
+of rows per thread; a band sums its first window once and then only slides. Within a row the
+column sums are updated one tile of columns at a time and the window slides over that tile at
+once, so the sums it reads are still in L1. Sums are uint16 when the largest window cost fits
+(grey up to 15x15), else int32; the arithmetic wraps exactly because every true sum fits.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from host.stereo.subpixel import FIT_NONE, fit_offset
+
+TILE_BYTES = 8192  # column sums updated per tile: well inside a 32 KiB L1 with the pixel rows
+
+
+def lane_types(channels: int, size: int) -> tuple[type, type]:
+    """(column-sum dtype, window-sum dtype): uint16 where the largest sum fits, else int32."""
+    top_col = 255 * channels * size
+    top_win = top_col * size
+    col = np.uint16 if top_col < 0xFFFF else np.int32
+    win = np.uint16 if top_win < 0xFFFF else np.int32
+    return col, win
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _absdiff(a, b):
+    return max(a, b) - min(a, b)
+
+
+@njit(cache=True, fastmath=True)
+def _cols_add(col, left, right_p, y, x0, x1, base0, nd):
+    # column sums of x in [x0, x1) gain row y (first window of a band)
+    for ch in range(left.shape[0]):
+        lrow = left[ch, y]
+        rrow = right_p[ch, y]
+        for x in range(x0, x1):
+            a = lrow[x]
+            c = col[x]
+            r = rrow[base0 + x:base0 + x + nd]
+            for k in range(nd):
+                c[k] += _absdiff(a, r[k])
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _cols_slide(col, left, right_p, y_new, y_old, x0, x1, base0, nd):
+    # column sums of x in [x0, x1) move one row down: y_new enters, y_old leaves
+    for ch in range(left.shape[0]):
+        ln = left[ch, y_new]
+        lo = left[ch, y_old]
+        rn_row = right_p[ch, y_new]
+        ro_row = right_p[ch, y_old]
+        for x in range(x0, x1):
+            a = ln[x]
+            o = lo[x]
+            c = col[x]
+            rn = rn_row[base0 + x:base0 + x + nd]
+            ro = ro_row[base0 + x:base0 + x + nd]
+            for k in range(nd):
+                c[k] = c[k] + _absdiff(a, rn[k]) - _absdiff(o, ro[k])
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _slide_min(win, enter, leave, idx):
+    """Window sums move one column right; returns the smallest candidate of the lowest sum.
+
+    Every comparison is between values of the window's own dtype (a uint16 against an int64
+    would go through float64 in numba), so all three loops run in full-width vector lanes.
+    """
+    for k in range(win.size):
+        win[k] = win[k] + enter[k] - leave[k]
+    m = win[0]
+    for k in range(1, win.size):
+        m = min(m, win[k])
+    none = idx[win.size]  # idx = 0 .. nd in the window's dtype
+    best = none
+    for k in range(win.size):
+        best = min(best, idx[k] if win[k] == m else none)
+    return best
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _slide(win, enter, leave):
+    for k in range(win.size):
+        win[k] = win[k] + enter[k] - leave[k]
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _decide(win, best, kmin, nd, uniqueness, fit):
+    """Uniqueness test and sub-pixel offset (k units) of the winner; ok False = rejected."""
+    c0 = np.float32(win[best])
+    if uniqueness > 0.0:
+        bound = c0 * (1.0 + uniqueness / 100.0)
+        for k in range(kmin, nd):
+            if (k < best - 1 or k > best + 1) and win[k] <= bound:
+                return 0.0, False
+    if fit == FIT_NONE or best <= kmin or best >= nd - 1:
+        return 0.0, True
+    return fit_offset(np.float32(win[best - 1]), c0, np.float32(win[best + 1]), fit), True
+
+
+@njit(cache=True, fastmath=True)
+def _first_min(win, kmin, nd):
+    m = win[kmin]
+    for k in range(kmin + 1, nd):
+        m = min(m, win[k])
+    best = kmin
+    while win[best] != m:
+        best += 1
+    return best
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _interior(col, win, idx, out, yi, x_from, x_to, half, dmin, nd, fit):
+    """The common case: both window columns inside, every candidate allowed, no uniqueness.
+
+    Reads the column sums by index (no views) and fuses the slide with the minimum.
+    """
+    none = idx[nd]
+    for x in range(x_from, x_to):
+        e = x + half
+        o = x - half - 1
+        win[0] = win[0] + col[e, 0] - col[o, 0]
+        m = win[0]
+        for k in range(1, nd):
+            win[k] = win[k] + col[e, k] - col[o, k]
+            m = min(m, win[k])
+        best = none
+        for k in range(nd):
+            best = min(best, idx[k] if win[k] == m else none)
+        off = 0.0
+        if fit != FIT_NONE and 0 < best < nd - 1:
+            off = fit_offset(np.float32(win[best - 1]), np.float32(m),
+                             np.float32(win[best + 1]), fit)
+        out[yi, x] = dmin + nd - 1 - best - off
+
+
+@njit(cache=True, fastmath=True)
+def _row_outputs(col, win, zero, idx, rowcost, out, yi, x_from, x_to, x_start, half, w, dmin,
+                 nd, top, uniqueness, fit, want_right):
+    """Slide the window over outputs x in [x_from, x_to) of one row, writing out[yi, x]."""
+    if x_from == x_start:
+        win[:] = 0
+        for xx in range(max(0, x_start - half), x_start + half):
+            _slide(win, col[xx], zero)
+    # outputs that need none of the edge rules below
+    fast_lo = max(x_from, half + 1, half + dmin + nd - 1)
+    fast_hi = min(x_to, w - half)
+    if uniqueness > 0.0 or want_right or fast_hi <= fast_lo:
+        fast_lo = fast_hi = x_to
+    x = x_from
+    while x < x_to:
+        if x == fast_lo:
+            _interior(col, win, idx, out, yi, fast_lo, fast_hi, half, dmin, nd, fit)
+            x = fast_hi
+            continue
+        enter = col[x + half] if x + half < w else zero
+        leave = col[x - half - 1] if x - half - 1 >= 0 else zero
+        # the right window of disparity d starts at max(0, x - half) - d: keep it inside
+        dmax = max(0, x - half) - dmin
+        kmin = max(0, nd - 1 - dmax)
+        x += 1
+        if kmin == 0:
+            k = _slide_min(win, enter, leave, idx)
+        else:
+            _slide(win, enter, leave)
+            if dmax < 0:
+                if want_right:
+                    rowcost[x - 1, :] = top
+                continue
+            k = _first_min(win, kmin, nd)
+        if want_right:
+            rowcost[x - 1, :] = win
+            rowcost[x - 1, :kmin] = top
+        off, ok = _decide(win, k, kmin, nd, uniqueness, fit)
+        if ok:
+            out[yi, x - 1] = dmin + nd - 1 - k - off
+
+
+@njit(cache=True, fastmath=True)
+def _right_row(rowcost, disp_r, y, w, x_start, x_end, dmin, nd, top, fit):
+    # the cost of right pixel xr at disparity d is the left cost at x = xr + d
+    c = np.empty(nd, dtype=rowcost.dtype)
+    for xr in range(w):
+        any_valid = False
+        for k in range(nd):
+            x = xr + dmin + nd - 1 - k
+            c[k] = rowcost[x, k] if x_start <= x < x_end else top
+            any_valid = any_valid or c[k] != top
+        if not any_valid:
+            continue
+        k = _first_min(c, 0, nd)
+        off, _ = _decide(c, k, 0, nd, 0.0, fit)
+        disp_r[y, xr] = dmin + nd - 1 - k - off
+
+
+@njit(cache=True, parallel=True, fastmath=True)
+def match_sad(left, right, dmin, nd, half, uniqueness, fit, want_right, clip, col_proto,
+              win_proto, top, nbands):
+    """Disparity maps (left, right) for uint8 images shaped (channels, rows, cols).
+
+    The cost sums over channels. clip: windows at the image edge are cropped to the image
+    instead of making the pixel invalid. dmin >= 0. col_proto / win_proto: empty arrays whose
+    dtypes are the lanes of the column and window sums (see lane_types); top: a window sum
+    no real cost reaches (the window dtype's largest value); nbands: bands of rows, one per
+    thread (numba.get_num_threads()).
+    """
+    nch, h, w = left.shape
+    disp_l = np.full((h, w), np.nan, dtype=np.float32)
+    disp_r = np.full((h, w), np.nan, dtype=np.float32)
+    ro = half if clip else 0  # zero rows above and below keep clipped sums exact
+    pad = nd + dmin + 1
+    left_p = np.zeros((nch, h + 2 * ro, w), dtype=np.uint8)
+    left_p[:, ro:ro + h, :] = left
+    right_p = np.zeros((nch, h + 2 * ro, w + 2 * pad), dtype=np.uint8)
+    right_p[:, ro:ro + h, pad:pad + w] = right
+    rows = h + 2 * ro - 2 * half
+    x_start = 0 if clip else half
+    x_end = w if clip else w - half
+    if rows <= 0 or x_end <= x_start:
+        return disp_l, disp_r
+    base0 = pad - dmin - (nd - 1)
+    cdt = col_proto.dtype
+    wdt = win_proto.dtype
+    tile = max(2 * half + 2, TILE_BYTES // (nd * col_proto.itemsize))
+    nbands = max(1, min(rows, nbands))
+    for band in prange(nbands):
+        y0 = half + rows * band // nbands
+        y1 = half + rows * (band + 1) // nbands
+        col = np.zeros((w, nd), dtype=cdt)
+        win = np.zeros(nd, dtype=wdt)
+        zero = np.zeros(nd, dtype=cdt)
+        idx = np.arange(nd + 1).astype(wdt)
+        rowcost = np.full((w if want_right else 1, nd), top, dtype=wdt)
+        for yy in range(y0 - half, y0 + half + 1):
+            _cols_add(col, left_p, right_p, yy, 0, w, base0, nd)
+        for y in range(y0, y1):
+            yi = y - ro  # image row
+            if y == y0:
+                _row_outputs(col, win, zero, idx, rowcost, disp_l, yi, x_start, x_end, x_start,
+                             half, w, dmin, nd, top, uniqueness, fit, want_right)
+            else:
+                done = x_start
+                for tx0 in range(0, w, tile):
+                    tx1 = min(w, tx0 + tile)
+                    _cols_slide(col, left_p, right_p, y + half, y - half - 1, tx0, tx1, base0,
+                                nd)
+                    upto = x_end if tx1 == w else min(x_end, tx1 - half)
+                    if upto > done:
+                        _row_outputs(col, win, zero, idx, rowcost, disp_l, yi, done, upto, x_start,
+                                     half, w, dmin, nd, top, uniqueness, fit, want_right)
+                        done = upto
+            if want_right:
+                _right_row(rowcost, disp_r, yi, w, x_start, x_end, dmin, nd, top, fit)
+    return disp_l, disp_r
