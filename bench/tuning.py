@@ -1,80 +1,102 @@
-"""Benchmark of the tuning methods: over 20 seeds, the median number of distinct evaluations
-each needs to come within 0.5 points of the grid optimum, on Cones and Teddy, for the 1-D window
-space and the 4-D sad space; random search at the Q-learner's budget; and generalisation
-(tune on one scene, score the tuned parameters on the other)."""
+"""Benchmark of tuning on the shared Middlebury scenes: the grid of every space on every scene is
+evaluated once (and cached), and everything else is read from those tables: leave-one-scene-out
+generalisation and the per-scene optimum beside the built-in defaults.
+
+Each scene gets its disparity range from its ground truth (+4 px), never a tuned number.
+Run: .venv/bin/python bench/tuning.py [--cache DIR] [--scenes a,b,...]
+"""
 
 from __future__ import annotations
 
+import argparse
+import hashlib
+import json
 import os
-import statistics
+import subprocess
 import sys
+import time
 from pathlib import Path
 
-from host.stereo import MatcherParams, load_scene
-from host.tuning.learners import tune
-from host.tuning.objective import Objective, mean_bad
-from host.tuning.spaces import make_space
+import numpy as np
 
-SEEDS = range(20)
-STEPS = {"paper": 20, "qlearning": 1500, "random": 10_000}
+from host.stereo import MatcherParams
+from host.stereo.scenes import Scene, load_scene
+from host.tuning.backends.local import LocalBackend
+from host.tuning.disparity_range import RangePolicy
+from host.tuning.ground_truth import GroundTruthScore
+from host.tuning.objective import SceneTable
+from host.tuning.spaces import Space, make_space
 
-
-def median_reach(results, target: float) -> str:
-    reach = [r.evaluations_to_reach(target) for r in results]
-    ok = [x for x in reach if x is not None]
-    if not ok:
-        return f"never (0/{len(reach)})"
-    med = statistics.median([x if x is not None else float("inf") for x in reach])
-    return f"{med:5.1f} ({len(ok)}/{len(reach)} runs reach it)"
+BASE = MatcherParams(border="clip")
+DEFAULTS = MatcherParams()  # what host eval uses with no options (border invalid)
+POLICY = RangePolicy("ground-truth", 4.0)
 
 
-def best_within(result, budget: int) -> float:
-    """The best bad % a run had found after `budget` distinct evaluations."""
-    return min(bad for _, bad in result.visited[:budget])
+def conditions() -> str:
+    load = subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
+    return f"{os.cpu_count()} cores, numba threads {os.environ.get('NUMBA_NUM_THREADS', 'all')}; " \
+           f"uptime: {load}"
+
+
+def grid_table(space: Space, scenes: list[Scene], ranges, cache: Path | None
+               ) -> np.ndarray:
+    """bad % of every state (rows, in grid order) on every scene (columns)."""
+    key = hashlib.sha1(repr((space, [s.name for s in scenes], ranges)).encode()).hexdigest()[:12]
+    path = cache / f"grid-{space.name}-{key}.json" if cache else None
+    if path and path.exists():
+        return np.array(json.loads(path.read_text()))
+    table = SceneTable(LocalBackend(GroundTruthScore(scenes, ranges)), space.params)
+    rows = np.array(table.get(space.states()))
+    if path:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(rows.tolist()))
+    return rows
+
+
+def leave_one_out(space: Space, names: list[str], table: np.ndarray,
+                  defaults: dict[str, float]) -> None:
+    print(f"\nleave-one-scene-out on the {space.name} space ({space.size} states): tuned by grid "
+          "on the mean of the other scenes, scored on the one left out (nonocc bad %)")
+    print(f"  {'scene':<9}{'left out':>9}{'own best':>9}{'defaults':>9}  parameters tuned on "
+          "the others")
+    picked = []
+    for i, name in enumerate(names):
+        others = [j for j in range(len(names)) if j != i]
+        pick = int(np.argmin(table[:, others].mean(axis=1)))
+        picked.append(table[pick, i])
+        print(f"  {name:<9}{table[pick, i]:9.2f}{table[:, i].min():9.2f}{defaults[name]:9.2f}  "
+              f"{space.values(space.states()[pick])}")
+    own = table.min(axis=0)
+    print(f"  mean: left out {np.mean(picked):.2f}, own best {own.mean():.2f}, defaults "
+          f"{np.mean(list(defaults.values())):.2f}; mean gap to the own best "
+          f"{np.mean(np.array(picked) - own):.2f} pt")
 
 
 def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--cache", type=Path, help="keep grid tables here between runs")
+    ap.add_argument("--scenes", help="comma-separated scene names (default: all shared)")
+    args = ap.parse_args()
     data = os.environ.get("STEREO_SERVO_DATA")
     if not data:
-        print("STEREO_SERVO_DATA is not set: the tuning benchmark needs Cones and Teddy")
+        print("STEREO_SERVO_DATA is not set: the tuning benchmark needs the Middlebury scenes")
         return 0
-    scenes = {n: load_scene(Path(data) / "middlebury" / n) for n in ("cones", "teddy")}
-    base = MatcherParams(num_disparities=64, border="clip")
-    tuned = {}
-    for space_name in ("window", "sad"):
-        space = make_space(space_name, base)
-        for name, scene in scenes.items():
-            obj = Objective.on_scenes([scene], space.params)
-            g = tune("grid", obj, space, 0, 0)
-            target = g.best_bad + 0.5
-            print(f"\n{space_name} space ({space.size} states) on {name}: grid optimum "
-                  f"{g.best_bad:.2f}% at {space.values(g.best_state)}; grid pays {space.size}")
-            methods = ["paper", "qlearning", "random"] if space_name == "window" else [
-                "qlearning", "random"]
-            runs = {m: [tune(m, obj, space, min(STEPS[m], space.size) if m == "random"
-                             else STEPS[m], s) for s in SEEDS] for m in methods}
-            for m, results in runs.items():
-                print(f"  {m:<10} evaluations to within 0.5 points: "
-                      f"{median_reach(results, target)}")
-            q = [r.evaluations_to_reach(target) or space.size for r in runs["qlearning"]]
-            budget = int(statistics.median(q))
-            rnd = [tune("random", obj, space, budget, s) for s in SEEDS]
-            hit_q = sum(r.evaluations_to_reach(target) is not None
-                        and r.evaluations_to_reach(target) <= budget for r in runs["qlearning"])
-            hit_r = sum(r.evaluations_to_reach(target) is not None for r in rnd)
-            print(f"  at the Q-learner's median budget of {budget} evaluations "
-                  f"({100 * budget / space.size:.1f}% of the grid): qlearning reaches it in "
-                  f"{hit_q}/20 runs, random in {hit_r}/20; median best bad qlearning "
-                  f"{statistics.median(best_within(r, budget) for r in runs['qlearning']):.2f}%, "
-                  f"random {statistics.median(r.best_bad for r in rnd):.2f}%")
-            tuned[(space_name, name)] = space.params(g.best_state)
-    print("\ngeneralisation (grid-tuned parameters, bad % nonocc):")
-    for space_name in ("window", "sad"):
-        for src, dst in (("cones", "teddy"), ("teddy", "cones")):
-            p = tuned[(space_name, src)]
-            own = mean_bad([scenes[dst]], tuned[(space_name, dst)])
-            print(f"  {space_name}: tuned on {src}: {mean_bad([scenes[src]], p):.2f}% there, "
-                  f"{mean_bad([scenes[dst]], p):.2f}% on {dst} (tuned on {dst} itself: {own:.2f}%)")
+    root = Path(data) / "middlebury"
+    names = args.scenes.split(",") if args.scenes else [
+        d.name for d in sorted(root.iterdir()) if (d / "meta.json").exists()]
+    scenes = [load_scene(root / n) for n in names]
+    ranges = [POLICY.resolve(s.left, s.right, gt=s.gt) for s in scenes]
+    print(f"tuning benchmark: {len(scenes)} scenes ({', '.join(names)}), ~450x375 px; "
+          f"{conditions()}")
+    defaults = dict(zip(names, GroundTruthScore(scenes, ranges)(DEFAULTS)))
+    tables = {}
+    for name in ("window", "sad"):
+        space = make_space(name, BASE)
+        t0 = time.perf_counter()
+        tables[name] = grid_table(space, scenes, ranges, args.cache)
+        print(f"grid of {name} ({space.size} states x {len(scenes)} scenes): "
+              f"{time.perf_counter() - t0:.1f} s (0 when cached)")
+    leave_one_out(make_space("sad", BASE), names, tables["sad"], defaults)
     return 0
 
 
