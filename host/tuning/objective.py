@@ -42,6 +42,8 @@ class Objective:
         self._batch = batch
         self._owner = owner  # its backend is shut down by close()
         self.cache: dict[State, float] = {}
+        # evaluations worth asking for at once (the backend's parallelism)
+        self.parallel = owner.backend.parallel if owner is not None else 1
 
     @classmethod
     def of(cls, table: SceneTable, scenes: Sequence[int] | None = None) -> Objective:

@@ -34,12 +34,12 @@ def scene():
     return synthetic_scene(seed=11, width=200, height=150, max_disp=24, noise=2.0)
 
 
-def test_window_tuning_ends_within_half_a_point_of_the_grid_best(scene) -> None:
+def test_guided_window_tuning_ends_within_half_a_point_of_the_grid_best(scene) -> None:
     space = make_space("window", MatcherParams(num_disparities=32), odd_range("3:27"))
     obj = gt_objective([scene], space)
     best_grid = tune("grid", obj, space, 0, 0).best_bad
     for seed in range(3):
-        r = tune("paper", obj, space, 20, seed)
+        r = tune("guided", obj, space, 20, seed)
         assert r.best_bad <= best_grid + 0.5, (seed, r.best_bad, best_grid)
 
 

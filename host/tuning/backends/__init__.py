@@ -12,6 +12,8 @@ Score = Callable[[MatcherParams], list[float]]
 
 
 class Backend(Protocol):
+    parallel: int  # how many evaluations it runs at once
+
     def map(self, params: Sequence[MatcherParams]) -> list[list[float]]: ...
 
     def close(self) -> None: ...

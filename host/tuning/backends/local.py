@@ -8,6 +8,8 @@ from host.stereo.params import MatcherParams
 
 
 class LocalBackend:
+    parallel = 1
+
     def __init__(self, score: Callable[[MatcherParams], list[float]]) -> None:
         self.score = score
 

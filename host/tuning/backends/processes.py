@@ -26,6 +26,7 @@ class ProcessBackend:
 
     def __init__(self, score: Callable[[MatcherParams], list[float]], workers: int) -> None:
         self.score = score
+        self.parallel = workers
         # spawn: numba's OpenMP threads and fork do not mix
         self._pool = ProcessPoolExecutor(workers, multiprocessing.get_context("spawn"),
                                          initializer=_init, initargs=(score,))

@@ -36,6 +36,7 @@ class RayBackend:
                 raise HostError(f"cannot start Ray on {where}: "
                                 f"{str(e).splitlines()[0] if str(e) else type(e).__name__}"
                                 ) from None
+        self.parallel = max(1, int(ray.cluster_resources().get("CPU", 1)))
         self._ref = ray.put(score)
         self._task = ray.remote(_evaluate)
         self._ray = ray
