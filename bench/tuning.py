@@ -114,7 +114,7 @@ def leave_one_out(space: Space, names: list[str], table: np.ndarray,
 
 
 SEEDS = range(20)
-BUDGET = {"paper": 20, "guided": 20, "qlearning": 1500, "random": 10_000, "tpe": 150}
+BUDGET = {"paper": 20, "guided": 20, "qlearning": 1500, "random": 10_000, "tpe": 100}
 COMPARE_SCENES = ("cones", "teddy", "tsukuba", "art")
 DESIGNED_ON = ("cones", "teddy")  # the self-supervised weights were chosen looking at these
 
@@ -146,7 +146,8 @@ def compare(space: Space, names: list[str], table: np.ndarray) -> None:
                 reach.append(r.evaluations_to_reach(target))
             ok = [x for x in reach if x is not None]
             med = np.median([x if x is not None else np.inf for x in reach])
-            cells.append(f"{med:7.1f} ({len(ok):2d}/{len(reach)})" if ok else
+            shown = f"{med:7.1f}" if np.isfinite(med) else "     - "  # most runs never do
+            cells.append(f"{shown} ({len(ok):2d}/{len(reach)})" if ok else
                          f"never (0/{len(reach)})")
         print("  " + f"{m:<10}" + "".join(f"{c:>16}" for c in cells))
 

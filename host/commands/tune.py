@@ -241,7 +241,8 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         from host.tuning.plot import plot
 
-        plot(result, args.plot)
+        plot(result, args.plot, score="bad pixels (%)" if args.objective == "gt"
+             else "self-supervised score (%)")
     out = result.to_json() | {"objective": args.objective,
                               "scenes": [s.name for s in tuned_on], "held_out": held,
                               "disparity_range": str(policy),
