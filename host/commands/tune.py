@@ -195,8 +195,11 @@ def run(args: argparse.Namespace) -> int:
         raise HostError(f"--tune-on must be 1..{len(scenes)}, got {args.tune_on}")
     if args.cv and len(scenes) < 2:
         raise HostError("--cv needs at least two scenes")
-    default_policy = "ground-truth" if all(s.gt is not None for s in scenes) else "coarse"
+    default_policy = "ground-truth" if args.objective == "gt" else "coarse"
     policy = RangePolicy.parse(args.range_policy or default_policy, args.range_margin)
+    if args.objective == "self" and policy.kind == "ground-truth":
+        raise HostError("the self-supervised objective uses no ground truth: choose --range "
+                        "coarse, depth:NEAR:FAR or fixed:N")
     ranges = _ranges(scenes, policy, focal_baseline)
     space = make_space(args.space, params_from_args(args), odd_range(args.windows))
     if args.method in ("paper", "guided") and len(space.dims) != 1:

@@ -117,6 +117,7 @@ def test_tune_on_the_simulated_camera_with_its_depth_range(tmp_path) -> None:
     (["--camera", "replay:/nonexistent", "--objective", "self"], "no such folder"),
     (["--camera", "replay:/x", "--objective", "self", "--range", "depth:1:3"], "no such"),
     (["--objective", "self", "--range", "depth:1:3"], "needs a calibration"),
+    (["--objective", "self", "--range", "ground-truth"], "uses no ground truth"),
 ])
 def test_camera_tuning_input_errors(argv, message) -> None:
     r = _tune(*argv)
