@@ -29,13 +29,7 @@ class RayBackend:
                                   "log_to_driver": False}
             if address is None:
                 kw["num_cpus"] = os.cpu_count() or 1
-            try:
-                ray.init(address=address, **kw)
-            except (ConnectionError, RuntimeError, ValueError) as e:
-                where = address or "a local cluster"
-                raise HostError(f"cannot start Ray on {where}: "
-                                f"{str(e).splitlines()[0] if str(e) else type(e).__name__}"
-                                ) from None
+            _init(ray, address, kw)
         self.parallel = max(1, int(ray.cluster_resources().get("CPU", 1)))
         self._ref = ray.put(score)
         self._task = ray.remote(_evaluate)
@@ -48,6 +42,21 @@ class RayBackend:
     def close(self) -> None:
         if self._started:
             self._ray.shutdown()
+
+
+def _init(ray: Any, address: str | None, kw: dict[str, Any], tries: int = 2) -> None:
+    """ray.init, tried again once: a loaded machine can miss Ray's fixed 30 s for a new
+    node to register. Any failure becomes one line."""
+    for attempt in range(tries):
+        try:
+            ray.init(address=address, **kw)
+            return
+        except Exception as e:  # Ray raises bare Exception for a node that did not start
+            ray.shutdown()
+            if attempt == tries - 1:
+                where = address or "a local cluster"
+                first = str(e).splitlines()[0] if str(e) else type(e).__name__
+                raise HostError(f"cannot start Ray on {where}: {first}") from None
 
 
 def _evaluate(score: Callable[[MatcherParams], list[float]], params: MatcherParams
