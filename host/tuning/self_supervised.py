@@ -34,12 +34,12 @@ EDGE_SIGMA = 8.0  # grey levels
 @dataclass(frozen=True)
 class Weights:
     """Weights of the terms in the score (reconstruction has weight 1). Chosen on Cones and
-    Teddy only (rank correlation with bad % over the sad space, 0.98 on both); the other eight
-    shared scenes are the test (bench/tuning.py, docs/tuning.md)."""
+    Teddy only (the bad % of the pick over the sad space, ranges by the coarse pass); the other
+    eight shared scenes are the test (bench/tuning.py, docs/tuning.md)."""
 
     inconsistency: float = 0.1
     invalid: float = 0.5
-    roughness: float = 0.15
+    roughness: float = 0.5
 
 
 @njit(cache=True)
