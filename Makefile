@@ -14,7 +14,7 @@ export STEREO_SERVO_DATA ?= $(if $(wildcard $(DATA)/middlebury/index.json),$(DAT
 
 $(BIN)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/pip install --quiet --disable-pip-version-check -e '.[test]'
+	$(BIN)/pip install --quiet --disable-pip-version-check -e '.[test,tpe,ray]'
 	$(BIN)/python -m host.stereo.warm  # numba compiles now, not in the user's first run
 	touch $@
 

@@ -31,10 +31,19 @@ def _table(name: str, data: dict[str, Any]) -> str:
 
 
 def save_params(path: str | os.PathLike[str], params: MatcherParams,
-                tuning: dict[str, Any] | None = None) -> None:
-    """Write [matcher] (every parameter) and [tuning] (method, scenes, score ...) atomically."""
+                tuning: dict[str, Any] | None = None,
+                disparity_range: dict[str, Any] | None = None) -> None:
+    """Write [matcher] (every parameter) and [tuning] (method, scenes, score ...) atomically.
+
+    With disparity_range (a policy, host.tuning.disparity_range) the matcher table leaves out
+    the range: the reader derives it from each scene or frame."""
     text = "# stereo-servo matcher parameters (host tune); read by host eval/servo --params\n"
-    text += _table("matcher", params.to_dict())
+    matcher = params.to_dict()
+    if disparity_range:
+        del matcher["num_disparities"], matcher["min_disparity"]
+    text += _table("matcher", matcher)
+    if disparity_range:
+        text += "\n" + _table("disparity_range", disparity_range)
     if tuning:
         text += "\n" + _table("tuning", tuning)
     write_text_atomic(path, text)
@@ -72,3 +81,11 @@ def load_params(path: str | os.PathLike[str]) -> tuple[MatcherParams, dict[str, 
     except TypeError as e:
         raise HostError(f"{p}: bad [matcher] table ({e})") from None
     return params, data.get("tuning", {})
+
+
+def load_disparity_range(path: str | os.PathLike[str]) -> dict[str, Any] | None:
+    """The [disparity_range] policy table of a params file, None when it fixes the range."""
+    try:
+        return tomllib.loads(Path(path).read_text()).get("disparity_range")
+    except (OSError, tomllib.TOMLDecodeError):
+        return None  # load_params reports the problem

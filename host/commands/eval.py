@@ -64,6 +64,20 @@ def score_scene(scene: Scene, params: MatcherParams, rho: float) -> dict[str, An
             "density": whole.density, "ms": ms, "disp": disp}
 
 
+def _scene_range(args: argparse.Namespace, params: MatcherParams, scene: Scene
+                 ) -> MatcherParams:
+    """The scene's disparity range: the params file's policy, else from ground truth."""
+    from host.params_file import load_disparity_range
+    from host.tuning.disparity_range import RangePolicy, apply_range
+
+    table = load_disparity_range(args.params) if args.params else None
+    if table is not None:
+        return apply_range(params, RangePolicy.from_table(table).resolve(
+            scene.left, scene.right, gt=scene.gt))
+    return params.replace(num_disparities=scene.num_disparities(
+        16 if params.matcher.startswith("opencv") else 1))
+
+
 def _fmt(v: float | None, spec: str = ".2f") -> str:
     return "-" if v is None or (isinstance(v, float) and math.isnan(v)) else format(v, spec)
 
@@ -96,8 +110,7 @@ def run(args: argparse.Namespace) -> int:
 
 def _score(scene: Scene, params: MatcherParams, args: argparse.Namespace) -> dict[str, Any]:
     """Score one scene; with --picture, stage its picture (named from the scene, made safe)."""
-    p = params if num_disp_given(args) else params.replace(
-        num_disparities=scene.num_disparities(16 if params.matcher.startswith("opencv") else 1))
+    p = params if num_disp_given(args) else _scene_range(args, params, scene)
     row = score_scene(scene, p, args.rho)
     if args.picture:
         path = check_output(inside(args.picture, safe_name(scene.name, ".png")), IMAGE,

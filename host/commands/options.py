@@ -8,7 +8,7 @@ import argparse
 import math
 from collections.abc import Callable
 
-from host.params_file import load_params
+from host.params_file import load_disparity_range, load_params
 from host.stereo.params import BORDERS, MATCHERS, MatcherParams
 
 
@@ -95,5 +95,7 @@ def params_from_args(args: argparse.Namespace) -> MatcherParams:
 
 
 def num_disp_given(args: argparse.Namespace) -> bool:
-    """Whether the disparity range came from the user (option or params file)."""
-    return args.num_disp is not None or args.params is not None
+    """Whether the disparity range came from the user (option, or a params file that fixes it
+    rather than storing a policy)."""
+    return args.num_disp is not None or (args.params is not None
+                                         and load_disparity_range(args.params) is None)

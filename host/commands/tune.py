@@ -1,69 +1,190 @@
-"""host tune: tune the matcher against ground truth (the paper's Q-learner and alternatives)."""
+"""host tune: tune the matcher's parameters on scenes with ground truth, or on a camera's own
+frames with the self-supervised objective; locally, in worker processes or on Ray."""
 
 from __future__ import annotations
 
 import argparse
 import datetime
 import json
+import re
 import sys
 from pathlib import Path
+from typing import Any
 
+from host.camera.open import add_camera_options, open_source, parse_size
 from host.commands.options import (
     COUNT,
     FRACTION,
+    NON_NEGATIVE,
     POSITIVE,
     SEED,
     add_matcher_options,
     int_range,
-    num_disp_given,
     params_from_args,
 )
 from host.errors import HostError
 from host.files import all_or_nothing, check_output
 from host.params_file import save_params
-from host.stereo.scenes import load_scenes
-from host.tuning.learners import METHODS, tune
-from host.tuning.objective import Objective, mean_bad
-from host.tuning.spaces import SPACES, make_space, odd_range
+from host.stereo.scenes import Scene, load_scenes
+from host.tuning.backends import make_backend
+from host.tuning.disparity_range import RangePolicy
+from host.tuning.ground_truth import GroundTruthScore
+from host.tuning.learners import METHODS, TuneResult, tune
+from host.tuning.objective import Objective, SceneTable
+from host.tuning.self_supervised import SelfSupervisedScore
+from host.tuning.spaces import SPACES, Space, make_space, odd_range
 
-DEFAULT_ITERATIONS = {"paper": 20, "qlearning": 300, "random": 60, "grid": 0}
+DEFAULT_ITERATIONS = {"paper": 20, "guided": 20, "qlearning": 300, "random": 60, "grid": 0,
+                      "tpe": 60}
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("tune", help="tune the matcher's parameters against ground truth")
+    p = sub.add_parser("tune", help="tune the matcher's parameters (against ground truth, or "
+                                    "self-supervised on a camera's frames)")
     p.add_argument("scenes", nargs="*", type=Path, metavar="SCENE_DIR",
                    help="scenes with ground truth (default: the embedded Motorcycle pair)")
+    p.add_argument("--objective", choices=("gt", "self"), default="gt",
+                   help="gt: bad %% against ground truth; self: self-supervised (census "
+                        "reconstruction, LR consistency, invalid, roughness), no ground truth")
+    p.add_argument("--frames", type=COUNT, default=4, metavar="N",
+                   help="--camera: tune on N pairs spread over what the camera gives")
     p.add_argument("--space", choices=SPACES, default="window",
                    help="parameters to tune: the window alone, or a matcher's several")
     p.add_argument("--method", choices=METHODS, default="paper",
-                   help="the paper's Q-learner, full Q-learning, grid or random search")
+                   help="the paper's eq. 6 learner, its guided variant, full Q-learning, grid, "
+                        "random search or Optuna's TPE")
     p.add_argument("--iterations", type=int_range(0),
-                   help="learner steps (default: paper 20, qlearning 300, random 60; grid: all)")
+                   help="learner steps (default: paper and guided 20, qlearning 300, random and "
+                        "tpe 60; grid: all)")
     p.add_argument("--seed", type=SEED, default=0, help="seed of the learner")
     p.add_argument("--workers", type=COUNT, default=1, help="parallel evaluation processes")
+    p.add_argument("--ray", nargs="?", const="local", metavar="ADDRESS",
+                   help="evaluate on Ray: a local cluster, or the one at ADDRESS (host:port, "
+                        "ray://host:port or auto); optional extra stereo-servo[ray]")
     p.add_argument("--windows", default="5:41", help="odd window sizes lo:hi (window space)")
     p.add_argument("--step", type=COUNT, default=1, help="action step in values of a parameter")
     p.add_argument("--alpha", type=FRACTION, help="qlearning: learning rate (default 0.5)")
-    p.add_argument("--gamma", type=FRACTION, help="discount (default: paper 0.8, qlearning 0.9)")
+    p.add_argument("--gamma", type=FRACTION,
+                   help="discount (default: paper and guided 0.8, qlearning 0.9)")
     p.add_argument("--epsilon", type=FRACTION,
-                   help="exploration (paper 0.2; qlearning 0.3 at the start, decaying)")
+                   help="exploration (paper 0, guided 0.2; qlearning 0.3 at the start, "
+                        "decaying)")
     p.add_argument("--episodes", type=COUNT, help="qlearning: episodes (default 20)")
-    p.add_argument("--tune-on", type=COUNT, metavar="N",
-                   help="tune on the first N scenes, report the others as held out")
+    p.add_argument("--range", dest="range_policy", metavar="POLICY",
+                   help="each scene's disparity range: ground-truth (default), coarse (a quick "
+                        "quarter-size pass), depth:NEAR:FAR (m, needs a calibration) or fixed:N")
+    p.add_argument("--range-margin", type=NON_NEGATIVE, default=4.0, metavar="PX",
+                   help="widen the derived range by this much on both sides (default 4 px)")
+    cv = p.add_mutually_exclusive_group()
+    cv.add_argument("--tune-on", type=COUNT, metavar="N",
+                    help="tune on the first N scenes, report the others as held out")
+    cv.add_argument("--cv", action="store_true",
+                    help="leave-one-scene-out: for each scene, tune on the others and score it")
     p.add_argument("--scale", type=POSITIVE, help="ground-truth scale for 2001/2003 layouts")
     p.add_argument("--out", type=Path, metavar="PARAMS.toml", help="write the tuned parameters")
     p.add_argument("--plot", type=Path, metavar="FIG.png", help="Figure 9 and the Q table")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     add_matcher_options(p)
-    p.set_defaults(run=run)
+    add_camera_options(p, sim=True)
+    p.set_defaults(run=run, camera=None)
 
 
-def _progress(total: int, enabled: bool):
+def _progress(total: int, enabled: bool, what: str):
+    """A progress bar on stderr (a terminal only), one tick per learner step."""
     if not enabled:
         return None
     from tqdm import tqdm
 
-    return tqdm(total=total, unit="step", file=sys.stderr, leave=False)
+    return tqdm(total=total, desc=what, unit="step", file=sys.stderr, mininterval=0.2,
+                dynamic_ncols=True)
+
+
+def _hyper(args: argparse.Namespace) -> dict[str, Any]:
+    hyper = {k: v for k, v in (("gamma", args.gamma), ("epsilon", args.epsilon),
+                               ("alpha", args.alpha), ("episodes", args.episodes))
+             if v is not None}
+    if args.method in ("paper", "guided", "qlearning"):
+        hyper["step"] = args.step
+    if args.method in ("paper", "guided") and ({"alpha", "episodes"} & set(hyper)):
+        raise HostError("--alpha and --episodes belong to --method qlearning")
+    if args.method in ("grid", "random", "tpe") and set(hyper) - {"step"}:
+        raise HostError(f"--method {args.method} takes no learning parameters")
+    if args.step < 1 or (args.episodes is not None and args.episodes < 1):
+        raise HostError("--step and --episodes must be at least 1")
+    for name in ("alpha", "gamma", "epsilon"):
+        value = getattr(args, name)
+        if value is not None and not 0.0 <= value <= 1.0:
+            raise HostError(f"--{name} must be in [0, 1], got {value}")
+    return hyper
+
+
+def _check_args(args: argparse.Namespace) -> int:
+    iterations = DEFAULT_ITERATIONS[args.method] if args.iterations is None else args.iterations
+    if args.method != "grid" and iterations < 1:
+        raise HostError(f"--iterations must be at least 1, got {iterations}")
+    if args.workers < 1:
+        raise HostError(f"--workers must be at least 1, got {args.workers}")
+    if args.ray is not None:
+        if args.workers > 1:
+            raise HostError("--workers and --ray are two ways to run evaluations: pick one")
+        if not (args.ray in ("local", "auto") or args.ray.startswith("ray://")
+                or re.fullmatch(r"[\w.\-]+:\d+", args.ray)):
+            raise HostError(f"--ray ADDRESS must be host:port, ray://host:port or auto, got "
+                            f"{args.ray!r} (put scene folders before --ray)")
+    if args.num_disp is not None or args.min_disp is not None:
+        raise HostError("tune derives each scene's disparity range: use --range "
+                        "(e.g. fixed:N) instead of --num-disp / --min-disp")
+    return iterations
+
+
+def _camera_scenes(args: argparse.Namespace) -> tuple[list[Scene], float | None]:
+    """Pairs from --camera as scenes without ground truth, and focal_px * baseline_m when the
+    geometry is known (calibration or simulation)."""
+    from host.tuning.frames import sim_pairs, spread_pairs
+
+    if args.frames < 1:
+        raise HostError(f"--frames must be at least 1, got {args.frames}")
+    focal_baseline = None
+    if args.camera == "sim":
+        pairs, focal_baseline = sim_pairs(*parse_size(args.size), args.frames)
+    else:
+        with open_source(args) as source:
+            pairs = spread_pairs(source, args.frames, live=args.camera == "minoru")
+        if args.calib:
+            from host.camera.calibration import Calibration
+
+            g = Calibration.load(args.calib).geometry
+            focal_baseline = g.focal_px * g.baseline_m
+    return [Scene(f"{args.camera.split(':')[0]}-{i}", left, right)
+            for i, (left, right) in enumerate(pairs)], focal_baseline
+
+
+def _ranges(scenes: list[Scene], policy: RangePolicy, focal_baseline: float | None
+            ) -> list[tuple[int, int]]:
+    return [policy.resolve(s.left, s.right, gt=s.gt, focal_baseline=focal_baseline)
+            for s in scenes]
+
+
+def _validate_space(space: Space, scenes: list[Scene], ranges: list[tuple[int, int]]) -> None:
+    """Every state must be a valid matcher on every scene (with that scene's range)."""
+    from host.tuning.disparity_range import apply_range
+
+    for s in space.states():
+        p = space.params(s)
+        for sc, r in zip(scenes, ranges):
+            apply_range(p, r).validate(width=sc.left.shape[1])
+
+
+def _run_method(args: argparse.Namespace, obj: Objective, space: Space, iterations: int,
+                hyper: dict[str, Any], show: bool, what: str) -> TuneResult:
+    total = space.size if args.method == "grid" else iterations
+    bar = _progress(total, show, what)
+    try:
+        return tune(args.method, obj, space, iterations, args.seed,
+                    on_step=bar.update if bar else None, **hyper)
+    finally:
+        if bar:
+            bar.close()
 
 
 def run(args: argparse.Namespace) -> int:
@@ -71,67 +192,100 @@ def run(args: argparse.Namespace) -> int:
         check_output(args.out, "toml", "--out")
     if args.plot:
         check_output(args.plot, "png", "--plot")
-    iterations = DEFAULT_ITERATIONS[args.method] if args.iterations is None else args.iterations
-    if args.method != "grid" and iterations < 1:
-        raise HostError(f"--iterations must be at least 1, got {iterations}")
-    scenes = load_scenes(args.scenes, args.scale)
+    iterations = _check_args(args)
+    hyper = _hyper(args)
+    if args.camera is not None and args.scenes:
+        raise HostError("give scene folders or --camera, not both")
+    if args.camera is not None and args.objective != "self":
+        raise HostError("a camera's frames have no ground truth: use --objective self")
+    focal_baseline = None
+    if args.camera is not None:
+        scenes, focal_baseline = _camera_scenes(args)
+    else:
+        scenes = load_scenes(args.scenes, args.scale)
     for s in scenes:
-        if s.gt is None:
-            raise HostError(f"{s.name}: no ground truth to tune against")
+        if s.gt is None and args.objective == "gt":
+            raise HostError(f"{s.name}: no ground truth to tune against "
+                            "(--objective self needs none)")
     n_tune = len(scenes) if args.tune_on is None else args.tune_on
     if not 1 <= n_tune <= len(scenes):
         raise HostError(f"--tune-on must be 1..{len(scenes)}, got {args.tune_on}")
-    tuned_on, held_out = scenes[:n_tune], scenes[n_tune:]
-    base = params_from_args(args)
-    if not num_disp_given(args):
-        base = base.replace(num_disparities=max(s.num_disparities(16) for s in scenes))
-    space = make_space(args.space, base, odd_range(args.windows))
-    if args.method == "paper" and len(space.dims) != 1:
-        raise HostError(f"the paper's learner tunes one parameter; space {space.name} has "
+    if args.cv and len(scenes) < 2:
+        raise HostError("--cv needs at least two scenes")
+    default_policy = "ground-truth" if args.objective == "gt" else "coarse"
+    policy = RangePolicy.parse(args.range_policy or default_policy, args.range_margin)
+    if args.objective == "self" and policy.kind == "ground-truth":
+        raise HostError("the self-supervised objective uses no ground truth: choose --range "
+                        "coarse, depth:NEAR:FAR or fixed:N")
+    ranges = _ranges(scenes, policy, focal_baseline)
+    space = make_space(args.space, params_from_args(args), odd_range(args.windows))
+    if args.method in ("paper", "guided") and len(space.dims) != 1:
+        raise HostError(f"the {args.method} learner tunes one parameter; space {space.name} has "
                         f"{len(space.dims)} (use --method qlearning)")
-    for s in space.states():  # every state must be a valid matcher on these images
-        space.params(s).validate(width=min(sc.left.shape[1] for sc in scenes))
-    hyper = {k: v for k, v in (("gamma", args.gamma), ("epsilon", args.epsilon),
-                               ("alpha", args.alpha), ("episodes", args.episodes))
-             if v is not None}
-    if args.method in ("paper", "qlearning"):
-        hyper["step"] = args.step
-    if args.method == "paper" and ({"alpha", "episodes"} & set(hyper)):
-        raise HostError("--alpha and --episodes belong to --method qlearning")
-    if args.method in ("grid", "random") and set(hyper) - {"step"}:
-        raise HostError(f"--method {args.method} takes no learning parameters")
-    obj = Objective.on_scenes(tuned_on, space.params, workers=args.workers)
-    total = space.size if args.method == "grid" else iterations
-    bar = _progress(total, not args.json and sys.stderr.isatty())
+    _validate_space(space, scenes, ranges)
+    score = (GroundTruthScore(scenes, ranges) if args.objective == "gt"
+             else SelfSupervisedScore([(s.left, s.right) for s in scenes], ranges))
+    show = not args.json and sys.stderr.isatty()
+    table = SceneTable(make_backend(score, args.workers, args.ray), space.params)
     try:
-        result = tune(args.method, obj, space, iterations, args.seed,
-                      on_step=bar.update if bar else None, **hyper)
+        folds = {}
+        if args.cv:
+            for i, held in enumerate(scenes):
+                others = [j for j in range(len(scenes)) if j != i]
+                r = _run_method(args, Objective.of(table, others), space, iterations, hyper,
+                                show, f"without {held.name}")
+                folds[held.name] = {"params": space.values(r.best_state),
+                                    "bad": table.get([r.best_state])[0][i],
+                                    "tuned_bad": r.best_bad}
+        result = _run_method(args, Objective.of(table, list(range(n_tune))), space,
+                             iterations, hyper, show, f"{args.method} on {args.space}")
+        row = table.get([result.best_state])[0]
     finally:
-        obj.close()
-        if bar:
-            bar.close()
+        table.close()
     best = space.params(result.best_state)
-    held = {s.name: mean_bad([s], best) for s in held_out}
+    tuned_on = scenes[:n_tune]
+    held = {s.name: row[i] for i, s in enumerate(scenes) if i >= n_tune}
+    truth = None
+    if args.objective == "self" and all(s.gt is not None for s in scenes):
+        # the self-tuned parameters scored against the ground truth it did not use
+        truth = dict(zip([s.name for s in scenes], GroundTruthScore(scenes, ranges)(best)))
     with all_or_nothing():  # both outputs, or neither
         if args.out:
             save_params(args.out, best, {
                 "method": args.method, "space": args.space, "seed": args.seed,
-                "scenes": [s.name for s in tuned_on], "bad": round(result.best_bad, 4),
+                "objective": {"gt": "ground-truth", "self": "self-supervised"}[args.objective],
+                "scenes": [s.name for s in tuned_on],
+                "bad" if args.objective == "gt" else "score": round(result.best_bad, 4),
                 "evaluations": result.evaluations,
-                "date": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")})
+                "date": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")},
+                disparity_range=policy.to_table())
         if args.plot:
             from host.tuning.plot import plot
 
-            plot(result, args.plot)
-    out = result.to_json() | {"scenes": [s.name for s in tuned_on], "held_out": held}
+            plot(result, args.plot, score="bad pixels (%)" if args.objective == "gt"
+                 else "self-supervised score (%)")
+    out = result.to_json() | {"objective": args.objective,
+                              "scenes": [s.name for s in tuned_on], "held_out": held,
+                              "disparity_range": str(policy),
+                              "ranges": {s.name: list(r) for s, r in zip(scenes, ranges)}}
+    if args.cv:
+        out["leave_one_out"] = folds
+    if truth is not None:
+        out["ground_truth_bad"] = truth
     if args.json:
         print(json.dumps(out, default=str))
         return 0
+    what = "bad" if args.objective == "gt" else "self-supervised score"
     print(f"{args.method} on {args.space} over {', '.join(out['scenes'])}: best "
-          f"{result.best_bad:.2f}% bad with {out['best_params']} after {len(result.history)} "
-          f"iterations, {result.evaluations} distinct evaluations")
+          f"{result.best_bad:.2f}% {what} with {out['best_params']} after "
+          f"{len(result.history)} iterations, {result.evaluations} distinct evaluations")
+    for name, bad in (truth or {}).items():
+        print(f"  {name}: {bad:.2f}% bad against its ground truth (not used for tuning)")
     for name, bad in held.items():
-        print(f"  held out {name}: {bad:.2f}% bad with the tuned parameters")
+        print(f"  held out {name}: {bad:.2f}% {what} with the tuned parameters")
+    for name, f in folds.items():
+        print(f"  left out {name}: {f['bad']:.2f}% {what} with {f['params']} "
+              f"(tuned on the others: {f['tuned_bad']:.2f}%)")
     if args.out:
-        print(f"  parameters written to {args.out}")
+        print(f"  parameters written to {args.out} (disparity range: {policy})")
     return 0

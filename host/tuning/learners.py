@@ -1,11 +1,17 @@
 """Tuning methods over a Space, all paying in distinct objective evaluations.
 
-- paper: the paper's learner. States are window sizes, actions shrink / keep / grow, Q starts at
-  zero, and each iteration applies the paper's equation 6, Q(s, a) = R(s, a) + gamma * max Q(s', .),
-  with epsilon-greedy action choice.
+- paper: the paper's learner exactly. States are window sizes, actions shrink / keep / grow, Q
+  starts at zero, the start state is drawn at random, and each of its 20 iterations takes the
+  action with the largest Q (ties drawn at random, keep included) and applies the paper's
+  equation 6, Q(s, a) = R(s, a) + gamma * max Q(s', .), gamma 0.8.
+- guided: the same states, actions and update with heuristics added to make it a reliable
+  hill-climber: epsilon-greedy (0.2), ties never go to keep, and among tied moves it repeats
+  one that improved and undoes one that did not.
 - qlearning: standard Q-learning, Q += alpha * (R + gamma * max Q(s', .) - Q), epsilon decaying
   over the run, in episodes that start from a random state or from the best state found so far.
 - grid: every state. random: states drawn without replacement.
+- tpe: Optuna's Tree-structured Parzen Estimator (multivariate), the standard optimiser, as a
+  baseline (optional dependency: pip install 'stereo-servo[tpe]').
 
 The reward is the improvement of the bad-pixel rate, R(s, a) = bad(s) - bad(s') in percentage
 points: positive for a move to a better state, zero for keep. With Q starting at zero, an untried
@@ -26,7 +32,7 @@ from host.errors import HostError
 from host.tuning.objective import Objective, State
 from host.tuning.spaces import Space
 
-METHODS = ("paper", "qlearning", "grid", "random")
+METHODS = ("paper", "guided", "qlearning", "grid", "random", "tpe")
 
 
 class Run:
@@ -35,6 +41,7 @@ class Run:
 
     def __init__(self, obj: Objective) -> None:
         self.obj = obj
+        self.parallel = obj.parallel
         self.visited: dict[State, float] = {}
 
     def __call__(self, state: State) -> float:
@@ -121,13 +128,42 @@ def _result(method: str, space: Space, run: Run, history: list[tuple[State, floa
     return TuneResult(method, space, best, best_bad, list(run.visited.items()), history, q or {})
 
 
-def paper(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
-          gamma: float = 0.8, epsilon: float = 0.2, step: int = 1,
-          on_step: Callable[[], None] | None = None) -> TuneResult:
+def _one_dimension(space: Space, method: str) -> int:
     if len(space.dims) != 1:
-        raise HostError(f"the paper's learner tunes one parameter; space {space.name} has "
+        raise HostError(f"the {method} learner tunes one parameter; space {space.name} has "
                         f"{len(space.dims)} (use --method qlearning)")
-    n = space.shape[0]
+    return space.shape[0]
+
+
+def paper(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
+          gamma: float = 0.8, epsilon: float = 0.0, step: int = 1,
+          on_step: Callable[[], None] | None = None) -> TuneResult:
+    """The paper's learner as published: greedy on Q with random tie-breaks, equation 6."""
+    n = _one_dimension(space, "paper's")
+    q = np.zeros((n, 3))  # actions: shrink, keep, grow
+    s = int(rng.integers(n))
+    bad_s = obj((s,))
+    history = []
+    for _ in range(iterations):
+        if rng.random() < epsilon:
+            a = int(rng.integers(3))
+        else:
+            a = int(rng.choice(np.flatnonzero(q[s] == q[s].max())))
+        s2 = min(max(s + (a - 1) * step, 0), n - 1)
+        bad2 = obj((s2,))
+        paper_update(q, s, a, bad_s - bad2, s2, gamma)
+        s, bad_s = s2, bad2
+        history.append(((s2,), bad2))
+        if on_step:
+            on_step()
+    return _result("paper", space, obj, history, {(i,): q[i].copy() for i in range(n)})
+
+
+def guided(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
+           gamma: float = 0.8, epsilon: float = 0.2, step: int = 1,
+           on_step: Callable[[], None] | None = None) -> TuneResult:
+    """Equation 6 with the hill-climbing heuristics (see the module's docstring)."""
+    n = _one_dimension(space, "guided")
     q = np.zeros((n, 3))  # actions: shrink, keep, grow
     s = int(rng.integers(n))
     bad_s = obj((s,))
@@ -144,7 +180,7 @@ def paper(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
         history.append(((s2,), bad2))
         if on_step:
             on_step()
-    return _result("paper", space, obj, history, {(i,): q[i].copy() for i in range(n)})
+    return _result("guided", space, obj, history, {(i,): q[i].copy() for i in range(n)})
 
 
 def qlearning(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
@@ -182,10 +218,11 @@ def qlearning(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
     return _result("qlearning", space, obj, history, dict(q))
 
 
-def _in_batches(obj: Run, states: list[State], on_step: Callable[[], None] | None,
-                batch: int = 32) -> list[tuple[State, float]]:
-    """Evaluate states in order, a batch at a time (in parallel when the objective has
-    workers); one history entry per state."""
+def _in_batches(obj: Run, states: list[State], on_step: Callable[[], None] | None
+                ) -> list[tuple[State, float]]:
+    """Evaluate states in order, a batch at a time (as many as the objective runs at once, so
+    progress shows as it goes); one history entry per state."""
+    batch = obj.parallel
     history = []
     for i in range(0, len(states), batch):
         part = states[i:i + batch]
@@ -207,6 +244,32 @@ def random_search(obj: Run, space: Space, iterations: int, rng: np.random.Genera
     return _result("random", space, obj, _in_batches(obj, picked, on_step))
 
 
+def tpe(obj: Run, space: Space, iterations: int, seed: int,
+        on_step: Callable[[], None] | None = None) -> TuneResult:
+    """Optuna's multivariate TPE sampler over the space's indices (categories for cyclic
+    dimensions, integers for ordered ones); a trial that repeats a state costs nothing more."""
+    try:
+        import optuna
+    except ImportError:
+        raise HostError("--method tpe needs Optuna: pip install 'stereo-servo[tpe]'") from None
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    sampler = optuna.samplers.TPESampler(seed=seed, multivariate=True)
+    study = optuna.create_study(sampler=sampler)
+    history: list[tuple[State, float]] = []
+
+    def objective(trial) -> float:
+        state = tuple(trial.suggest_categorical(d.name, list(range(len(d.values)))) if d.cyclic
+                      else trial.suggest_int(d.name, 0, len(d.values) - 1) for d in space.dims)
+        bad = obj(state)
+        history.append((state, bad))
+        if on_step:
+            on_step()
+        return bad
+
+    study.optimize(objective, n_trials=iterations)
+    return _result("tpe", space, obj, history)
+
+
 def tune(method: str, obj: Objective, space: Space, iterations: int, seed: int,
          on_step: Callable[[], None] | None = None, **hyper: Any) -> TuneResult:
     """Run a method by name; iterations is ignored by grid (it visits every state)."""
@@ -216,6 +279,10 @@ def tune(method: str, obj: Objective, space: Space, iterations: int, seed: int,
     run = Run(obj)
     if method == "paper":
         return paper(run, space, iterations, rng, on_step=on_step, **hyper)
+    if method == "guided":
+        return guided(run, space, iterations, rng, on_step=on_step, **hyper)
+    if method == "tpe":
+        return tpe(run, space, iterations, seed, on_step=on_step)
     if method == "qlearning":
         return qlearning(run, space, iterations, rng, on_step=on_step, **hyper)
     if method == "grid":

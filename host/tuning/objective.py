@@ -1,73 +1,59 @@
-"""The tuning objective: mean bad-pixel rate (%) of a state's matcher over scenes, memoised;
-its count of distinct evaluations is what a tuning method pays."""
+"""The objective a learner sees: f(state) -> a score to minimise, memoised; its count of distinct
+evaluations is what a tuning method pays. Where the score is computed (this process, worker
+processes, Ray) is the backend's business, never the learner's."""
 
 from __future__ import annotations
 
-import multiprocessing
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor
 
-from host.errors import HostError
-from host.stereo.matcher import compute_disparity
-from host.stereo.metrics import evaluate
 from host.stereo.params import MatcherParams
-from host.stereo.scenes import Scene
+from host.tuning.backends import Backend
 
 State = tuple[int, ...]
 
 
-def scene_bad(scene: Scene, params: MatcherParams, rho: float = 1.0) -> float:
-    """Bad % of params on one scene: over the nonocc region where the scene has that mask,
-    else over every pixel with known ground truth."""
-    assert scene.gt is not None
-    disp = compute_disparity(scene.left, scene.right, params)
-    return evaluate(disp, scene.gt, scene.masks.get("nonocc"), rho).bad
+class SceneTable:
+    """state -> one score per scene, computed by a backend and remembered, so that objectives
+    over different subsets of the scenes (leave-one-out folds) share every evaluation."""
 
+    def __init__(self, backend: Backend, params_of: Callable[[State], MatcherParams]) -> None:
+        self.backend, self.params_of = backend, params_of
+        self.rows: dict[State, tuple[float, ...]] = {}
 
-def mean_bad(scenes: Sequence[Scene], params: MatcherParams, rho: float = 1.0) -> float:
-    return sum(scene_bad(s, params, rho) for s in scenes) / len(scenes)
+    def get(self, states: Sequence[State]) -> list[tuple[float, ...]]:
+        todo = [s for s in dict.fromkeys(states) if s not in self.rows]
+        if todo:
+            got = self.backend.map([self.params_of(s) for s in todo])
+            self.rows.update((s, tuple(r)) for s, r in zip(todo, got))
+        return [self.rows[s] for s in states]
 
-
-_worker_scenes: Sequence[Scene] = ()
-
-
-def _init_worker(scenes: Sequence[Scene]) -> None:
-    global _worker_scenes
-    _worker_scenes = scenes
-
-
-def _worker_eval(args: tuple[MatcherParams, float]) -> float:
-    return mean_bad(_worker_scenes, *args)
+    def close(self) -> None:
+        self.backend.close()
 
 
 class Objective:
-    """f(state) -> mean bad %, memoised. Either over scenes (with a params function from a
-    space), or any function of the state (synthetic landscapes in tests)."""
+    """f(state) -> score (lower is better), memoised. Either a score of matcher parameters run
+    by a backend (Objective.of), or any function of the state (landscapes in tests, tables)."""
 
-    def __init__(self, fn: Callable[[State], float], batch: Callable[[list[State]], list[float]]
-                 | None = None, pool: ProcessPoolExecutor | None = None) -> None:
+    def __init__(self, fn: Callable[[State], float],
+                 batch: Callable[[list[State]], list[float]] | None = None,
+                 owner: SceneTable | None = None) -> None:
         self._fn = fn
         self._batch = batch
-        self._pool = pool  # the worker processes behind batch, shut down by close()
+        self._owner = owner  # its backend is shut down by close()
         self.cache: dict[State, float] = {}
+        # evaluations worth asking for at once (the backend's parallelism)
+        self.parallel = owner.backend.parallel if owner is not None else 1
 
     @classmethod
-    def on_scenes(cls, scenes: Sequence[Scene], params_of: Callable[[State], MatcherParams],
-                  rho: float = 1.0, workers: int = 1) -> Objective:
-        for s in scenes:
-            if s.gt is None:
-                raise HostError(f"scene {s.name} has no ground truth to tune against")
-        pool = None
-        if workers > 1:
-            # spawn: numba's OpenMP threads and fork do not mix
-            pool = ProcessPoolExecutor(workers, multiprocessing.get_context("spawn"),
-                                       initializer=_init_worker, initargs=(list(scenes),))
+    def of(cls, table: SceneTable, scenes: Sequence[int] | None = None) -> Objective:
+        """The mean of the table's per-scene scores over the given scenes (default: all)."""
+        def mean(row: tuple[float, ...]) -> float:
+            picked = row if scenes is None else [row[i] for i in scenes]
+            return sum(picked) / len(picked)
 
-        def batch(states: list[State]) -> list[float]:
-            assert pool is not None
-            return list(pool.map(_worker_eval, [(params_of(s), rho) for s in states]))
-
-        return cls(lambda s: mean_bad(scenes, params_of(s), rho), batch if pool else None, pool)
+        return cls(lambda s: mean(table.get([s])[0]),
+                   lambda states: [mean(r) for r in table.get(states)], table)
 
     @property
     def evaluations(self) -> int:
@@ -79,12 +65,18 @@ class Objective:
         return self.cache[state]
 
     def many(self, states: list[State]) -> list[float]:
-        """Evaluate several states (in parallel processes when workers > 1)."""
+        """Evaluate several states (in one batch for the backend)."""
         todo = [s for s in dict.fromkeys(states) if s not in self.cache]
         if todo and self._batch is not None:
             self.cache.update(zip(todo, self._batch(todo)))
         return [self(s) for s in states]
 
     def close(self) -> None:
-        if self._pool is not None:
-            self._pool.shutdown()
+        if self._owner is not None:
+            self._owner.close()
+
+    def __enter__(self) -> Objective:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

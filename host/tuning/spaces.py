@@ -13,7 +13,8 @@ from host.stereo.params import MatcherParams
 
 @dataclass(frozen=True)
 class Dimension:
-    name: str  # a MatcherParams field, or p1_factor / p2_factor (times channels * block_size^2)
+    name: str  # a MatcherParams field; p1_factor / p2_factor (times channels * block_size^2);
+    # lr_fill: the left-right check's tolerance (px) with filling, None = neither
     values: tuple[Any, ...]
     cyclic: bool = False  # categories without an order: a step wraps round
 
@@ -45,6 +46,9 @@ class Space:
     def params(self, state: tuple[int, ...]) -> MatcherParams:
         v = self.values(state)
         p1, p2 = v.pop("p1_factor", None), v.pop("p2_factor", None)
+        if "lr_fill" in v:  # the check only invalidates; filling makes it pay
+            tol = v.pop("lr_fill")
+            v |= {"lr_check": tol, "fill": tol is not None}
         params = self.base.replace(**v)
         # OpenCV's penalties scale with the matched channels: 3 for colour, 1 for grey
         area = (3 if params.colour else 1) * params.block_size ** 2
@@ -89,14 +93,15 @@ SPACES = ("window", "sad", "opencv-bm", "opencv-sgbm")
 
 def make_space(name: str, base: MatcherParams, windows: tuple[int, ...] = odd_range("5:41")
                ) -> Space:
-    """The named space around base (which fixes every parameter the space does not vary)."""
+    """The named space around base (which fixes every parameter the space does not vary).
+
+    No space tunes the disparity range: it is the scene's (host.tuning.disparity_range)."""
     if name == "window":
         return Space(name, (Dimension("block_size", windows),), base)
     if name == "sad":
         return Space(name, (
             Dimension("block_size", tuple(w for w in windows if w <= 25)),
-            Dimension("num_disparities", (48, 64, 80, 96)),
-            Dimension("lr_check", (None, 2.0, 1.0, 0.5)),  # by strictness: off = no limit
+            Dimension("lr_fill", (None, 2.0, 1.0, 0.5)),  # by strictness: off = no limit
             Dimension("matcher", ("sad", "ssd", "ncc"), cyclic=True),
         ), base)
     if name == "opencv-bm":

@@ -51,8 +51,9 @@ def bowl_4d(state) -> float:
     return 5 + 0.4 * abs(a - 7) + 0.8 * abs(b - 2) + (0.0, 2.5, 1.0)[c] + 0.6 * abs(d - 4)
 
 
-@pytest.mark.parametrize("method, iterations", [("paper", 30), ("qlearning", 200),
-                                                ("grid", 0), ("random", 19)])
+@pytest.mark.parametrize("method, iterations", [("paper", 30), ("guided", 30),
+                                                ("qlearning", 200), ("grid", 0), ("random", 19),
+                                                ("tpe", 60)])
 def test_each_method_finds_the_optimum_of_a_1d_bowl(method: str, iterations: int) -> None:
     for seed in range(5):
         r = tune(method, Objective(bowl_1d), WINDOW, iterations, seed)
@@ -66,6 +67,41 @@ def test_multi_parameter_methods_find_the_optimum_of_a_4d_landscape(method, iter
         assert r.best_state == (7, 2, 0, 4)
     if method == "qlearning":
         assert r.evaluations < FOUR_D.size * 0.3
+
+
+def test_the_paper_learner_is_greedy_equation_6_from_zeros(monkeypatch) -> None:
+    import host.tuning.learners as learners
+
+    calls = []
+    real = learners.paper_update
+
+    def spy(q, s, a, reward, s_next, gamma):
+        calls.append((q.copy(), s, a, reward, s_next, gamma))
+        real(q, s, a, reward, s_next, gamma)
+
+    monkeypatch.setattr(learners, "paper_update", spy)
+    starts = set()
+    for seed in range(8):
+        calls.clear()
+        r = tune("paper", Objective(bowl_1d), WINDOW, 20, seed)
+        assert len(calls) == len(r.history) == 20
+        assert not calls[0][0].any()  # Q starts at zero
+        starts.add(calls[0][1])
+        for q, s, a, reward, s_next, gamma in calls:
+            assert q[s, a] == q[s].max()  # greedy (ties drawn at random)
+            assert s_next == min(max(s + a - 1, 0), WINDOW.shape[0] - 1)
+            assert reward == pytest.approx(bowl_1d((s,)) - bowl_1d((s_next,)))
+            assert gamma == 0.8
+        assert [(s2,) for *_, s2, _ in calls] == [s for s, _ in r.history]
+    assert len(starts) > 3  # a random start state
+
+
+def test_tpe_is_reproducible_and_counts_repeated_trials_once() -> None:
+    pytest.importorskip("optuna", reason="Optuna is not installed (stereo-servo[tpe])")
+    a = tune("tpe", Objective(bowl_4d), FOUR_D, 40, seed=1)
+    b = tune("tpe", Objective(bowl_4d), FOUR_D, 40, seed=1)
+    assert a.history == b.history and len(a.history) == 40
+    assert a.evaluations == len({s for s, _ in a.history})
 
 
 def test_runs_are_reproducible_with_a_seed() -> None:

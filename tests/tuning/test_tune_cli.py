@@ -15,9 +15,18 @@ from host.cli import main
 from host.params_file import load_params
 from host.stereo import MatcherParams
 from host.stereo.synthetic import synthetic_scene
+from host.tuning.backends import make_backend
+from host.tuning.disparity_range import RangePolicy
+from host.tuning.ground_truth import GroundTruthScore
 from host.tuning.learners import tune
-from host.tuning.objective import Objective
+from host.tuning.objective import Objective, SceneTable
 from host.tuning.spaces import make_space, odd_range
+
+
+def gt_objective(scenes, space, workers: int = 1) -> Objective:
+    ranges = [RangePolicy().resolve(s.left, s.right, gt=s.gt) for s in scenes]
+    return Objective.of(SceneTable(make_backend(GroundTruthScore(scenes, ranges), workers),
+                                   space.params))
 
 
 @pytest.fixture(scope="module")
@@ -25,12 +34,12 @@ def scene():
     return synthetic_scene(seed=11, width=200, height=150, max_disp=24, noise=2.0)
 
 
-def test_window_tuning_ends_within_half_a_point_of_the_grid_best(scene) -> None:
+def test_guided_window_tuning_ends_within_half_a_point_of_the_grid_best(scene) -> None:
     space = make_space("window", MatcherParams(num_disparities=32), odd_range("3:27"))
-    obj = Objective.on_scenes([scene], space.params)
+    obj = gt_objective([scene], space)
     best_grid = tune("grid", obj, space, 0, 0).best_bad
     for seed in range(3):
-        r = tune("paper", obj, space, 20, seed)
+        r = tune("guided", obj, space, 20, seed)
         assert r.best_bad <= best_grid + 0.5, (seed, r.best_bad, best_grid)
 
 
@@ -97,8 +106,8 @@ def test_an_interrupted_run_leaves_no_params_file(tmp_path: Path) -> None:
 
 def test_parallel_workers_give_the_same_result_as_one_process(scene) -> None:
     space = make_space("window", MatcherParams(num_disparities=32), odd_range("5:11"))
-    one = Objective.on_scenes([scene], space.params)
-    two = Objective.on_scenes([scene], space.params, workers=2)
+    one = gt_objective([scene], space)
+    two = gt_objective([scene], space, workers=2)
     try:
         a, b = tune("grid", one, space, 0, 0), tune("grid", two, space, 0, 0)
     finally:

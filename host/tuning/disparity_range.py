@@ -1,0 +1,143 @@
+"""The disparity range as a policy derived from each scene, never a tuned constant.
+
+Policies (text form in brackets, as --range takes it and params files store it):
+- ground-truth [ground-truth]: the scene's known disparities, widened by the margin.
+- depth [depth:NEAR:FAR]: the calibration's depth range in metres, d = focal * baseline / Z.
+- coarse [coarse]: a quick ZNCC pass at quarter size with a left-right check; its 1st to 99th
+  percentile, scaled back up and widened by the margin.
+- fixed [fixed:N]: disparities 0..N-1 (for a user who knows the rig).
+A range is (min_disparity, num_disparities) in px, as MatcherParams takes them.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import cv2
+import numpy as np
+
+from host.errors import HostError
+
+KINDS = ("ground-truth", "depth", "coarse", "fixed")
+COARSE_FACTOR = 4
+
+
+@dataclass(frozen=True)
+class RangePolicy:
+    """How to find a scene's disparity range; margin_px widens it on both sides."""
+
+    kind: str = "ground-truth"
+    margin_px: float = 4.0
+    near_m: float | None = None  # depth policy
+    far_m: float | None = None
+    num: int | None = None  # fixed policy
+
+    @classmethod
+    def parse(cls, text: str, margin_px: float = 4.0) -> RangePolicy:
+        """ground-truth | coarse | depth:NEAR:FAR (m) | fixed:N (px)."""
+        kind, _, rest = text.partition(":")
+        try:
+            if kind == "depth":
+                near, far = (float(v) for v in rest.split(":"))
+                return cls(kind, margin_px, near_m=near, far_m=far).check()
+            if kind == "fixed":
+                return cls(kind, 0.0, num=int(rest)).check()
+        except ValueError:
+            raise HostError(f"disparity range {text!r}: expected depth:NEAR:FAR (m) or "
+                            "fixed:N (px)") from None
+        if kind in ("ground-truth", "coarse") and not rest:
+            return cls(kind, margin_px).check()
+        raise HostError(f"unknown disparity range {text!r} (choose from ground-truth, coarse, "
+                        "depth:NEAR:FAR, fixed:N)")
+
+    def check(self) -> RangePolicy:
+        if self.margin_px < 0:
+            raise HostError(f"range margin must be >= 0 px, got {self.margin_px}")
+        if self.kind == "depth" and not (self.near_m and self.far_m
+                                         and 0 < self.near_m < self.far_m):
+            raise HostError(f"depth range needs 0 < near < far, got {self.near_m}:{self.far_m}")
+        if self.kind == "fixed" and not (self.num and self.num > 0):
+            raise HostError(f"fixed range needs N > 0, got {self.num}")
+        return self
+
+    def __str__(self) -> str:
+        if self.kind == "depth":
+            return f"depth:{self.near_m:g}:{self.far_m:g}"
+        if self.kind == "fixed":
+            return f"fixed:{self.num}"
+        return self.kind
+
+    def to_table(self) -> dict[str, Any]:
+        """What a params file stores under [disparity_range]."""
+        out: dict[str, Any] = {"policy": str(self)}
+        if self.kind != "fixed":
+            out["margin_px"] = float(self.margin_px)
+        return out
+
+    @classmethod
+    def from_table(cls, table: dict[str, Any]) -> RangePolicy:
+        if "policy" not in table:
+            raise HostError("[disparity_range] has no policy")
+        return cls.parse(str(table["policy"]), float(table.get("margin_px", 4.0)))
+
+    def resolve(self, left: np.ndarray, right: np.ndarray, gt: np.ndarray | None = None,
+                focal_baseline: float | None = None, multiple: int = 1) -> tuple[int, int]:
+        """(min_disparity, num_disparities) for this pair; num rounded up to `multiple`.
+
+        gt: ground truth (px, NaN unknown) for ground-truth; focal_baseline: focal_px *
+        baseline_m for depth."""
+        if self.kind == "fixed":
+            assert self.num is not None
+            return 0, _round_up(self.num, multiple)
+        if self.kind == "ground-truth":
+            if gt is None or not np.isfinite(gt).any():
+                raise HostError("the ground-truth disparity range needs a scene with ground "
+                                "truth (use --range coarse)")
+            lo, hi = float(np.nanmin(gt)), float(np.nanmax(gt))
+        elif self.kind == "depth":
+            if focal_baseline is None:
+                raise HostError("the depth range needs a calibration (--calib)")
+            assert self.near_m is not None and self.far_m is not None
+            lo, hi = focal_baseline / self.far_m, focal_baseline / self.near_m
+        else:
+            lo, hi = coarse_range(left, right)
+        lo = max(0, math.floor(lo - self.margin_px))
+        top = math.ceil(hi + self.margin_px)
+        width = left.shape[1]
+        num = _round_up(max(top - lo + 1, multiple), multiple)
+        if lo + num > width // 2:  # never search more than half the image
+            num = max(multiple, (width // 2 - lo) // multiple * multiple)
+        return lo, num
+
+
+def _round_up(n: int, multiple: int) -> int:
+    return -(-n // multiple) * multiple
+
+
+def coarse_range(left: np.ndarray, right: np.ndarray) -> tuple[float, float]:
+    """(low, high) disparity in full-size px from a quick quarter-size ZNCC pass."""
+    from host.stereo.matcher import compute_disparity
+    from host.stereo.params import MatcherParams
+
+    f = COARSE_FACTOR
+    small = [cv2.resize(im, (im.shape[1] // f, im.shape[0] // f), interpolation=cv2.INTER_AREA)
+             for im in (left, right)]
+    width = small[0].shape[1]
+    p = MatcherParams(matcher="ncc", block_size=5, num_disparities=max(4, width // 3),
+                      border="clip", lr_check=1.0, uniqueness_ratio=5.0)
+    disp = compute_disparity(small[0], small[1], p)
+    valid = disp[np.isfinite(disp)]
+    if valid.size < 0.05 * disp.size:
+        return 0.0, float(width // 3 * f)  # featureless: search the whole coarse range
+    lo, hi = np.percentile(valid, (1, 99))
+    return float(lo * f - f), float(hi * f + f)
+
+
+def apply_range(params: Any, rng: tuple[int, int]) -> Any:
+    """params (MatcherParams) with the range; OpenCV's matchers get num rounded up to 16."""
+    lo, num = rng
+    if params.matcher.startswith("opencv"):
+        num = _round_up(num, 16)
+    return params.replace(min_disparity=lo, num_disparities=num)

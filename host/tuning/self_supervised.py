@@ -1,0 +1,146 @@
+"""The self-supervised objective: how well a matcher's disparity explains a stereo pair, from the
+pair alone (no ground truth), so a robot can tune on its own frames.
+
+For a pair and parameters it computes the left disparity, and the right one from the mirrored
+pair, and scores four terms (each a fraction of the image, 0 best):
+- reconstruction: the census (7x7, exposure-robust) Hamming distance between each left pixel
+  and the right pixel its disparity points at, over the bits;
+- inconsistency: valid left pixels whose right disparity disagrees by more than 1 px;
+- invalid: pixels with no disparity, or pointing outside the right image;
+- roughness: disparity jumps (> 1 px) between neighbours where the image has no edge
+  (weighted by exp(-|grey step| / 8)), so noise is paid for and object boundaries are free.
+The score is their weighted sum in percent; lower is better. A plain left-right failure rate on
+its own prefers the largest window (its maps are smooth and agree with themselves); the
+reconstruction term pays for the fattened edges of large windows.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from host.stereo.grey import to_grey
+from host.stereo.matcher import compute_disparity
+from host.stereo.params import MatcherParams
+from host.tuning.disparity_range import apply_range
+
+CENSUS_RADIUS = 3  # 7x7 window: 48 comparison bits
+EDGE_SIGMA = 8.0  # grey levels
+
+
+@dataclass(frozen=True)
+class Weights:
+    """Weights of the terms in the score (reconstruction has weight 1). Chosen on Cones and
+    Teddy only (the bad % of the pick over the sad space, ranges by the coarse pass); the other
+    eight shared scenes are the test (bench/tuning.py, docs/tuning.md)."""
+
+    inconsistency: float = 0.1
+    invalid: float = 0.5
+    roughness: float = 0.5
+
+
+@njit(cache=True)
+def census(grey: np.ndarray, radius: int) -> np.ndarray:
+    """Census transform: bit k set where the k-th neighbour is darker than the centre
+    (pixels beyond the border repeat the edge)."""
+    h, w = grey.shape
+    out = np.zeros((h, w), np.uint64)
+    for y in range(h):
+        for x in range(w):
+            c = grey[y, x]
+            bits = np.uint64(0)
+            for dy in range(-radius, radius + 1):
+                yy = min(max(y + dy, 0), h - 1)
+                for dx in range(-radius, radius + 1):
+                    if dy == 0 and dx == 0:
+                        continue
+                    xx = min(max(x + dx, 0), w - 1)
+                    bits = (bits << np.uint64(1)) | np.uint64(grey[yy, xx] < c)
+            out[y, x] = bits
+    return out
+
+
+@njit(cache=True)
+def _popcount(v: np.uint64) -> int:
+    n = 0
+    while v:
+        v &= v - np.uint64(1)
+        n += 1
+    return n
+
+
+@njit(cache=True)
+def _terms(disp_l: np.ndarray, disp_r: np.ndarray, cl: np.ndarray, cr: np.ndarray,
+           grey: np.ndarray, bits: int, sigma: float) -> tuple[float, float, float, float]:
+    h, w = disp_l.shape
+    recon = 0.0
+    inconsistent = 0
+    invalid = 0
+    rough = 0.0
+    pairs = 0
+    for y in range(h):
+        for x in range(w):
+            d = disp_l[y, x]
+            xr = int(np.floor(x - d + 0.5)) if not np.isnan(d) else -1
+            if xr < 0 or xr >= w:
+                invalid += 1
+            else:
+                recon += _popcount(cl[y, x] ^ cr[y, xr]) / bits
+                if not abs(disp_r[y, xr] - d) <= 1.0:
+                    inconsistent += 1
+            for dy, dx in ((0, 1), (1, 0)):
+                y2, x2 = y + dy, x + dx
+                if y2 >= h or x2 >= w:
+                    continue
+                pairs += 1
+                d2 = disp_l[y2, x2]
+                if np.isnan(d) or np.isnan(d2) or abs(d - d2) > 1.0:
+                    step = abs(float(grey[y, x]) - float(grey[y2, x2]))
+                    rough += np.exp(-step / sigma)
+    n = h * w
+    return recon / n, inconsistent / n, invalid / n, rough / max(pairs, 1)
+
+
+def terms(left: np.ndarray, right: np.ndarray, params: MatcherParams) -> dict[str, float]:
+    """The four terms (fractions, 0 best) of the matcher's disparity for one rectified pair."""
+    disp_l = compute_disparity(left, right, params)
+    mirrored = compute_disparity(np.ascontiguousarray(right[:, ::-1]),
+                                 np.ascontiguousarray(left[:, ::-1]), params)
+    return terms_of_maps(left, right, disp_l, np.ascontiguousarray(mirrored[:, ::-1]))
+
+
+def terms_of_maps(left: np.ndarray, right: np.ndarray, disp_l: np.ndarray,
+                  disp_r: np.ndarray) -> dict[str, float]:
+    """The four terms for given left and right disparity maps (px, NaN = none; the right map
+    holds, at a right pixel, the disparity of its left match)."""
+    disp_l, disp_r = (np.ascontiguousarray(d, np.float32) for d in (disp_l, disp_r))
+    gl, gr = to_grey(left), to_grey(right)
+    cl, cr = census(gl, CENSUS_RADIUS), census(gr, CENSUS_RADIUS)
+    bits = (2 * CENSUS_RADIUS + 1) ** 2 - 1
+    recon, inc, inv, rough = _terms(disp_l, disp_r, cl, cr, gl, bits, EDGE_SIGMA)
+    return {"reconstruction": recon, "inconsistency": inc, "invalid": inv, "roughness": rough}
+
+
+def score_of(t: dict[str, float], w: Weights = Weights()) -> float:
+    """The weighted sum of the terms, in percent."""
+    return 100 * (t["reconstruction"] + w.inconsistency * t["inconsistency"]
+                  + w.invalid * t["invalid"] + w.roughness * t["roughness"])
+
+
+class SelfSupervisedScore:
+    """params -> self-supervised score per pair (lower is better); picklable for any backend.
+
+    pairs are (left, right) uint8 images; ranges their (min_disparity, num_disparities)."""
+
+    name = "self-supervised (census reconstruction, LR consistency, invalid, roughness)"
+
+    def __init__(self, pairs: Sequence[tuple[np.ndarray, np.ndarray]],
+                 ranges: Sequence[tuple[int, int]], weights: Weights = Weights()) -> None:
+        self.pairs, self.ranges, self.weights = list(pairs), list(ranges), weights
+
+    def __call__(self, params: MatcherParams) -> list[float]:
+        return [score_of(terms(left, right, apply_range(params, r)), self.weights)
+                for (left, right), r in zip(self.pairs, self.ranges)]

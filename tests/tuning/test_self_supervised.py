@@ -1,0 +1,124 @@
+"""The self-supervised objective scores disparity from a stereo pair alone."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from host.stereo import MatcherParams
+from host.stereo.synthetic import synthetic_scene
+from host.tuning.disparity_range import RangePolicy
+from host.tuning.ground_truth import GroundTruthScore
+from host.tuning.self_supervised import SelfSupervisedScore, score_of, terms_of_maps
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return synthetic_scene(seed=5, width=240, height=160, max_disp=24, noise=1.0)
+
+
+def right_map(gt: np.ndarray) -> np.ndarray:
+    """The right view's disparity from the left's: the nearest surface landing on each pixel."""
+    h, w = gt.shape
+    out = np.full_like(gt, np.nan)
+    for y in range(h):
+        for x in range(w):
+            d = gt[y, x]
+            if np.isfinite(d):
+                xr = int(round(x - d))
+                if 0 <= xr < w and not out[y, xr] >= d:
+                    out[y, xr] = d
+    return out
+
+
+def test_the_true_disparity_scores_better_than_wrong_ones(scene) -> None:
+    gt = np.nan_to_num(scene.gt, nan=float(np.nanmin(scene.gt)))
+    true = score_of(terms_of_maps(scene.left, scene.right, gt, right_map(gt)))
+    shifted = gt + 3
+    assert score_of(terms_of_maps(scene.left, scene.right, shifted, right_map(shifted))) > true
+    noisy = gt.copy()
+    rng = np.random.default_rng(0)
+    spots = rng.random(gt.shape) < 0.2
+    noisy[spots] += rng.uniform(-6, 6, int(spots.sum()))
+    t_noisy = terms_of_maps(scene.left, scene.right, noisy, right_map(gt))
+    t_true = terms_of_maps(scene.left, scene.right, gt, right_map(gt))
+    assert t_noisy["roughness"] > t_true["roughness"]
+    assert t_noisy["inconsistency"] > t_true["inconsistency"]
+    assert score_of(t_noisy) > true
+    holes = gt.copy()
+    holes[:, ::4] = np.nan
+    assert terms_of_maps(scene.left, scene.right, holes, right_map(gt))["invalid"] >= 0.25
+
+
+def test_reconstruction_is_robust_to_an_exposure_change(scene) -> None:
+    gt = np.nan_to_num(scene.gt, nan=float(np.nanmin(scene.gt)))
+    darker = np.clip(scene.right.astype(np.float32) * 0.6 + 10, 0, 255).astype(np.uint8)
+    same = terms_of_maps(scene.left, scene.right, gt, right_map(gt))["reconstruction"]
+    dark = terms_of_maps(scene.left, darker, gt, right_map(gt))["reconstruction"]
+    assert abs(dark - same) < 0.02
+
+
+def test_self_score_ranks_matchers_like_ground_truth_on_a_synthetic_scene(scene) -> None:
+    rng = RangePolicy("coarse", 4).resolve(scene.left, scene.right)
+    gt_rng = RangePolicy().resolve(scene.left, scene.right, gt=scene.gt)
+    candidates = [MatcherParams(border="clip", block_size=w, lr_check=1.0, fill=True)
+                  for w in (3, 9, 25)] + [MatcherParams(border="clip", block_size=9)]
+    self_score = SelfSupervisedScore([(scene.left, scene.right)], [rng])
+    truth = GroundTruthScore([scene], [gt_rng])
+    s = [self_score(p)[0] for p in candidates]
+    g = [truth(p)[0] for p in candidates]
+    assert int(np.argmin(s)) == int(np.argmin(g)), (s, g)
+    assert int(np.argmax(s)) == int(np.argmax(g)), (s, g)
+
+
+def _tune(*argv: str):
+    import subprocess
+    import sys
+
+    return subprocess.run([sys.executable, "-m", "host", "tune", *argv], capture_output=True,
+                          text=True)
+
+
+def test_tune_on_replayed_frames_without_ground_truth(tmp_path, scene) -> None:
+    import cv2
+
+    from host.params_file import load_disparity_range, load_params
+
+    frames = tmp_path / "frames"
+    frames.mkdir()
+    for i, seed in enumerate((5, 6)):
+        s = synthetic_scene(seed=seed, width=160, height=120, max_disp=20, noise=1.0)
+        cv2.imwrite(str(frames / f"left_{i:03d}.png"), s.left)
+        cv2.imwrite(str(frames / f"right_{i:03d}.png"), s.right)
+    out = tmp_path / "tuned.toml"
+    r = _tune("--camera", f"replay:{frames}", "--objective", "self", "--method", "grid",
+              "--windows", "5:9", "--border", "clip", "--frames", "2", "--out", str(out))
+    assert r.returncode == 0, r.stderr
+    assert "self-supervised score" in r.stdout
+    params, tuning = load_params(out)
+    assert tuning["objective"] == "self-supervised" and tuning["scenes"] == ["replay-0",
+                                                                             "replay-1"]
+    assert params.block_size in (5, 7, 9)
+    assert load_disparity_range(out)["policy"] == "coarse"
+
+
+def test_tune_on_the_simulated_camera_with_its_depth_range(tmp_path) -> None:
+    out = tmp_path / "tuned.toml"
+    r = _tune("--camera", "sim", "--objective", "self", "--method", "random", "--iterations",
+              "2", "--windows", "7:11", "--frames", "1", "--range", "depth:0.8:3.5",
+              "--out", str(out))
+    assert r.returncode == 0, r.stderr
+    assert 'policy = "depth:0.8:3.5"' in out.read_text()
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--camera", "sim"], "use --objective self"),
+    (["--camera", "sim", "--objective", "self", "--frames", "0"], "--frames must be"),
+    (["--camera", "replay:/nonexistent", "--objective", "self"], "no such folder"),
+    (["--camera", "replay:/x", "--objective", "self", "--range", "depth:1:3"], "no such"),
+    (["--objective", "self", "--range", "depth:1:3"], "needs a calibration"),
+    (["--objective", "self", "--range", "ground-truth"], "uses no ground truth"),
+])
+def test_camera_tuning_input_errors(argv, message) -> None:
+    r = _tune(*argv)
+    assert r.returncode == 2 and message in r.stderr and r.stderr.count("\n") == 1
