@@ -27,6 +27,8 @@ EXAMPLES = {
                   "host calibrate shots/ --out calib.yml --ros ros/ --picture check.png"],
     "servo": ["host servo --sim --log run.csv --plot run.png",
               "host servo --port /dev/ttyACM0 --calib calib.yml --params tuned.toml"],
+    "view": ["host view --camera minoru --calib calib.yml      # look without a robot",
+             "host view --camera replay:shots/ --view 127.0.0.1:8080"],
     "emulate": ["host emulate --drop 0.01     # then: host servo --port /dev/pts/N ...",
                 "host emulate --simavr --duration 60"],
 }

@@ -11,7 +11,7 @@ from collections.abc import Iterator
 
 from host.camera.calibration import Calibration, Geometry
 from host.camera.open import add_camera_options, open_source, parse_size
-from host.commands.options import add_matcher_options, params_from_args
+from host.commands.options import POSITIVE, add_matcher_options, params_from_args
 from host.errors import HostError
 from host.servo.marker import find_marker
 from host.servo.snapshot import Snapshot
@@ -54,7 +54,7 @@ def open_view(address: str | None, servo=None) -> Iterator[object | None]:
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("view", help="look at the stereo camera live in a browser (no robot)")
     add_view_option(p, default="127.0.0.1:0")
-    p.add_argument("--duration", type=float, metavar="S", help="stop after S seconds")
+    p.add_argument("--duration", type=POSITIVE, metavar="S", help="stop after S seconds")
     add_camera_options(p)
     add_matcher_options(p)
     p.set_defaults(run=run)

@@ -113,7 +113,7 @@ def test_tune_on_the_simulated_camera_with_its_depth_range(tmp_path) -> None:
 
 @pytest.mark.parametrize("argv, message", [
     (["--camera", "sim"], "use --objective self"),
-    (["--camera", "sim", "--objective", "self", "--frames", "0"], "--frames must be"),
+    (["--camera", "sim", "--objective", "self", "--frames", "0"], "--frames: must be >= 1"),
     (["--camera", "replay:/nonexistent", "--objective", "self"], "no such folder"),
     (["--camera", "replay:/x", "--objective", "self", "--range", "depth:1:3"], "no such"),
     (["--objective", "self", "--range", "depth:1:3"], "needs a calibration"),
