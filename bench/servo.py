@@ -13,8 +13,8 @@ from host.emulator.emulator import Emulator, PtyService
 from host.link.client import RobotLink
 from host.servo.controller import ControlConfig
 from host.servo.loop import Servo
-from host.servo.sim_source import SimSource
-from host.servo.world import World
+from host.sim.source import SimSource
+from host.sim.world import World
 from host.stereo import MatcherParams
 from host.stereo.matcher import warm_up
 

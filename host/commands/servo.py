@@ -101,8 +101,8 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _sim(args, emulator):
-    from host.servo.sim_source import SimSource
-    from host.servo.world import World
+    from host.sim.source import SimSource
+    from host.sim.world import World
 
     w, h = parse_size(args.size)
     world = World.for_size(w, h)

@@ -9,8 +9,8 @@ from host.emulator.emulator import Emulator, Faults, PtyService
 from host.link.client import RobotLink
 from host.servo.controller import ControlConfig
 from host.servo.loop import Servo
-from host.servo.sim_source import SimSource
-from host.servo.world import World
+from host.sim.source import SimSource
+from host.sim.world import World
 from host.stereo import MatcherParams
 
 PARAMS = MatcherParams(block_size=9, num_disparities=48, border="clip")
