@@ -31,11 +31,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--settle", type=float, default=1.0, metavar="S",
                    help="end after holding at the target this long (0: run on)")
     p.add_argument("--tolerance-cm", type=float, default=1.0,
-                   help="stop within this depth of the target (converted to px there)")
+                   help="hold within this depth of the target (widened, and said so, when below "
+                        "the depth noise measured there)")
     p.add_argument("--mode", choices=("turn", "reverse"), default="turn",
                    help="to come back: turn round and drive (the paper) or reverse")
-    p.add_argument("--turn-s", type=float, help="seconds a turn round takes (default: the "
-                                                "simulated robot's, 2 s on a real one)")
     p.add_argument("--max-duty", type=int, default=600)
     p.add_argument("--min-duty", type=int, default=180, help="least duty that moves the robot")
     p.add_argument("--marker", choices=("disc", "aruco"), default="disc")
@@ -43,6 +42,20 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="radius of the marker's dark disc (0: do not check sizes)")
     p.add_argument("--start-depth", type=float, default=1.9, help="sim: robot's start (m)")
     p.add_argument("--fps", type=float, default=30.0, help="sim: frame rate")
+    p.add_argument("--faults", action="store_true",
+                   help="sim: a world that fails like hardware (random faults from --seed)")
+    p.add_argument("--seed", type=int, default=0, help="sim: seed of the world and its faults")
+    p.add_argument("--trials", type=int, metavar="N",
+                   help="sim: N randomized runs of the faulty world, then their summary")
+    p.add_argument("--json", type=Path, metavar="trials.json",
+                   help="with --trials: write every trial and the summary")
+    p.add_argument("--workers", type=int, default=2, help="with --trials: processes")
+    p.add_argument("--drop", type=float, default=0.0, help="sim: byte drop probability")
+    p.add_argument("--corrupt", type=float, default=0.0,
+                   help="sim: byte corruption probability")
+    p.add_argument("--delay-ms", type=float, default=0.0, help="sim: line delay (ms)")
+    p.add_argument("--silent-after", type=float, metavar="MS",
+                   help="sim: the robot goes silent after MS ms")
     add_camera_options(p, sim=True)
     add_matcher_options(p)
     p.set_defaults(run=run)
@@ -60,11 +73,11 @@ class _Status:
         if not self.tty or now - self._last < 0.1:
             return
         self._last = now
-        robot = f"{row.robot_px:6.2f}" if math.isfinite(row.robot_px) else "   ---"
-        err = f"{row.error_px:+6.2f}" if math.isfinite(row.error_px) else "   ---"
+        robot = f"{row.depth_m:6.3f}" if math.isfinite(row.depth_m) else "   ---"
+        err = f"{row.error_m * 100:+6.1f}" if math.isfinite(row.error_m) else "   ---"
         hz = f"{row.loop_hz:5.1f}" if math.isfinite(row.loop_hz) else "  ---"
-        sys.stderr.write(f"\r{row.t:7.2f} s  {row.phase:<5}  target {row.target_px:6.2f} px  "
-                         f"robot {robot} px  error {err}  cmd {row.left:5d} {row.right:5d}  "
+        sys.stderr.write(f"\r{row.t:7.2f} s  {row.phase:<7}  target {row.target_m:6.3f} m  "
+                         f"robot {robot} m  error {err} cm  cmd {row.left:5d} {row.right:5d}  "
                          f"{hz} Hz ")
         sys.stderr.flush()
 
@@ -74,62 +87,90 @@ class _Status:
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.sim:
-        args.camera, args.port = "sim", args.port or "emulator"
+    if args.sim or args.camera == "sim":
+        if args.port not in (None, "emulator"):
+            raise HostError("--camera sim needs --port emulator (the simulated robot)")
+        return _run_sim(args)
+    if args.trials or args.faults:
+        raise HostError("--trials and --faults need --sim")
     if not args.port:
         raise HostError("--port is needed (a serial port, or 'emulator'); --sim runs it all "
                         "simulated")
     params = params_from_args(args)
     with contextlib.ExitStack() as stack:
-        emulator, service = None, None
+        service = None
         if args.port == "emulator":
             from host.emulator.emulator import Emulator, PtyService
 
-            emulator = Emulator(line_rate=args.camera != "sim")
-            service = stack.enter_context(PtyService(emulator, realtime=args.camera != "sim"))
-        if args.camera == "sim":
-            if emulator is None:
-                raise HostError("--camera sim needs --port emulator (the simulated robot)")
-            source, world, geometry, clock = _sim(args, emulator)
-        else:
-            source = stack.enter_context(open_source(args))
-            world, clock = None, time.monotonic
-            geometry = (Calibration.load(args.calib).geometry if args.calib
-                        else Geometry.minoru_default(*parse_size(args.size)))
+            service = stack.enter_context(PtyService(Emulator(_link_faults(args))))
+        source = stack.enter_context(open_source(args))
+        geometry = (Calibration.load(args.calib).geometry if args.calib
+                    else Geometry.minoru_default(*parse_size(args.size)))
         link = stack.enter_context(RobotLink(service.path if service else args.port))
-        return _servo(args, params, source, link, geometry, world, clock)
+        servo = Servo(source, link, params, geometry, _control(args), marker=args.marker,
+                      marker_radius_m=args.marker_radius_cm / 100 if args.marker_radius_cm
+                      else None)
+        return _servo(args, servo, geometry, None, time.monotonic)
 
 
-def _sim(args, emulator):
-    from host.sim.source import SimSource
-    from host.sim.world import World
+def _link_faults(args):
+    from host.emulator.emulator import Faults
 
-    w, h = parse_size(args.size)
-    world = World.for_size(w, h)
-    world.robot.z_m = args.start_depth
-    source = SimSource(world, emulator, args.fps)
-    return source, world, world.geometry, source.clock
+    for name in ("drop", "corrupt"):
+        if not 0.0 <= getattr(args, name) <= 1.0:
+            raise HostError(f"--{name} must be a probability between 0 and 1")
+    if args.delay_ms < 0:
+        raise HostError("--delay-ms must not be negative")
+    return Faults(drop=args.drop, corrupt=args.corrupt, delay_ms=args.delay_ms,
+                  silent_after_ms=args.silent_after, seed=args.seed)
 
 
-def _servo(args, params, source, link, geometry, world, clock) -> int:
-    turn_s = args.turn_s or (world.motors.turn_seconds(ControlConfig.turn_duty) if world
-                             else 2.0)
-    servo = Servo(source, link, params, geometry, ControlConfig(
-        max_duty=args.max_duty, min_duty=args.min_duty, mode=args.mode, turn_s=turn_s),
-        marker=args.marker, clock=clock,
-        marker_radius_m=args.marker_radius_cm / 100 if args.marker_radius_cm else None,
-        tolerance_m=args.tolerance_cm / 100)
+def _control(args) -> ControlConfig:
+    if args.tolerance_cm <= 0:
+        raise HostError("--tolerance-cm must be positive")
+    return ControlConfig(tolerance_m=args.tolerance_cm / 100, max_duty=args.max_duty,
+                         min_duty=args.min_duty, mode=args.mode)
+
+
+def _run_sim(args) -> int:
+    import dataclasses
+
+    import numpy as np
+
+    from host.sim.faults import WorldFaults, random_faults
+    from host.sim.run import Setup, simulation
+
+    params = params_from_args(args)
+    if args.trials:
+        from host.sim.trials import run_trials
+
+        return run_trials(args.trials, args.seed, parse_size(args.size), params, args.json,
+                          workers=args.workers)
+    faults = WorldFaults()
+    if args.faults:
+        faults = random_faults(np.random.default_rng(args.seed), 1.2)
+    link = _link_faults(args)
+    if link != type(link)(seed=args.seed):
+        faults = dataclasses.replace(faults, link=link)
+    setup = Setup(parse_size(args.size), args.start_depth, faults=faults, seed=args.seed,
+                  fps=args.fps, params=params, control=_control(args))
+    with simulation(setup, reference=False) as sim:
+        return _servo(args, sim.servo, sim.world.geometry, sim.world, sim.source.clock)
+
+
+def _servo(args, servo, geometry, world, clock) -> int:
     target = servo.reference()
     z = geometry.depth_m(target.disparity)
-    tol = servo.control.tolerance_px
     print(f"target: nearest object at disparity {target.disparity:.2f} px ({z:.3f} m), "
-          f"{target.area} px; tolerance {tol:.3f} px = {args.tolerance_cm:g} cm there",
-          file=sys.stderr)
+          f"{target.area} px; tolerance {servo.tolerance_m * 100:g} cm", file=sys.stderr)
     status = _Status()
     t0 = clock()
     try:
-        while True:
+        while not servo.stop_reason:
             row = servo.step(world.robot.z_m if world else math.nan)
+            for note in servo.notes:
+                print(f"note: {note}", file=sys.stderr)
+            servo.notes.clear()
             status.show(row)
             if args.duration is not None and clock() - t0 >= args.duration:
                 break
@@ -144,10 +185,13 @@ def _servo(args, params, source, link, geometry, world, clock) -> int:
                 write_csv(args.log, servo.rows)
             if args.plot:
                 plot_run(args.plot, servo.rows, geometry)
+    outcome, reason = servo.outcome()
     last = servo.rows[-1]
-    robot_z = geometry.depth_m(last.robot_px) if last.robot_px > 0 else math.nan
-    msg = (f"held at disparity {last.robot_px:.2f} px ({robot_z:.3f} m) against the target's "
-           f"{target.disparity:.2f} px after {last.t - t0:.1f} s")
+    if outcome == "held":
+        msg = (f"held at {last.depth_m:.3f} m (disparity {last.robot_px:.2f} px) against the "
+               f"target's {servo.target_m:.3f} m after {last.t - t0:.1f} s")
+    else:
+        msg = f"stopped: {reason} (after {last.t - t0:.1f} s, phase {last.phase})"
     if world is not None:
         msg += (f"; true robot depth {world.robot.z_m:.3f} m, nearest box "
                 f"{world.nearest_box().z_m:.3f} m")
