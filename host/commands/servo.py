@@ -49,6 +49,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="sim: N randomized runs of the faulty world, then their summary")
     p.add_argument("--json", type=Path, metavar="trials.json",
                    help="with --trials: write every trial and the summary")
+    p.add_argument("--nominal", action="store_true",
+                   help="with --trials: the world without faults")
     p.add_argument("--workers", type=int, default=2, help="with --trials: processes")
     p.add_argument("--drop", type=float, default=0.0, help="sim: byte drop probability")
     p.add_argument("--corrupt", type=float, default=0.0,
@@ -144,8 +146,10 @@ def _run_sim(args) -> int:
     if args.trials:
         from host.sim.trials import run_trials
 
+        if args.trials < 1 or args.workers < 1:
+            raise HostError("--trials and --workers must be at least 1")
         return run_trials(args.trials, args.seed, parse_size(args.size), params, args.json,
-                          workers=args.workers)
+                          workers=args.workers, nominal=args.nominal)
     faults = WorldFaults()
     if args.faults:
         faults = random_faults(np.random.default_rng(args.seed), 1.2)

@@ -75,7 +75,7 @@ def random_faults(rng: np.random.Generator, target_z: float, target_index: int =
                                       for _ in range(2)),
                           skew_ms=float(rng.uniform(0, 33)), exposure_ms=float(rng.uniform(5, 30)),
                           drop=float(rng.uniform(0, 0.05)), noise=float(rng.uniform(1.5, 3.5)),
-                          distortion=_pair(rng, -0.12, 0.05))
+                          )
     events: list[Event] = []
     if rng.random() < 0.3:  # the target is pushed nearer or farther
         events.append(Event(float(rng.uniform(1, 8)), "move", target_index,

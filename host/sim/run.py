@@ -73,7 +73,7 @@ def simulation(setup: Setup = Setup(), reference: bool = True) -> Iterator[SimRu
     emulator = Emulator(link_faults, line_rate=False)
     renderer = Renderer(world, faults.camera, seed=setup.seed)
     with PtyService(emulator, realtime=False) as service, \
-            RobotLink(service.path, retries=setup.retries, reply_timeout_s=0.05) as link:
+            RobotLink(service.path, retries=setup.retries, reply_timeout_s=0.2) as link:
         source = SimSource(world, emulator, setup.fps, renderer=renderer, events=faults.events,
                            latency_ms=faults.motor.latency_ms + faults.link.delay_ms,
                            seed=setup.seed)
