@@ -34,7 +34,14 @@ from host.camera.source import CameraError, StereoFrame, StereoSource
 from host.errors import HostError
 from host.servo.controller import Command, ControlConfig, Controller, Observation
 from host.servo.marker import MarkerPair, block_disparity, find_marker
-from host.servo.perception import Floor, Target, nearest_object, reference_target, without_floor
+from host.servo.perception import (
+    Floor,
+    Target,
+    match_exposure,
+    nearest_object,
+    reference_target,
+    without_floor,
+)
 from host.stereo.matcher import compute_disparity
 from host.stereo.params import MatcherParams
 
@@ -76,7 +83,7 @@ class Servo:
                  reference_frames: int = 5, min_area: int | None = None, stale_s: float = 0.3,
                  clock: Callable[[], float] = time.monotonic, full_map: bool = False,
                  max_mismatch_px: float = 1.5, marker_radius_m: float | None = 0.03,
-                 max_skew_s: float = 0.045, remeasure_s: float = 0.5, noise_frames: int = 8,
+                 max_skew_s: float = 0.045, remeasure_s: float = 1.0, noise_frames: int = 8,
                  robot_half_width_m: float = 0.12, robot_below_marker_m: float = 0.22) -> None:
         self.source, self.link, self.params = source, link, params
         self.geometry, self.control, self.marker = geometry, control, marker
@@ -107,10 +114,12 @@ class Servo:
         self._last_capture: float | None = None
 
     def _frame(self) -> StereoFrame:
+        """The next pair, the right view brought to the left's exposure."""
         frame = self.source.read()
         if frame is None:
             raise CameraError("the camera ended")
-        return frame
+        return StereoFrame(frame.left, match_exposure(frame.left, frame.right), frame.t_left,
+                           frame.t_right)
 
     # ------------------------------------------------------------------ reference phase
 

@@ -46,6 +46,11 @@ class Renderer:
         self._static: list[tuple[np.ndarray, np.ndarray]] = []
         self._body_tex = random_texture(np.random.default_rng(seed + 1), 64, 64, 1.2, 45, 110)
         self._lens = [lens_maps(world, k1) for k1 in camera.distortion]
+        w, h = world.size
+        # sensor noise: a bank of independent fields, one drawn at random per view (drawing a
+        # fresh field per view costs more than the rest of the rendering)
+        self._noise = (self.rng.normal(0.0, camera.noise, (8, h, w)).astype(np.float32)
+                       if camera.noise else None)
 
     # ------------------------------------------------------------------------ static scene
 
@@ -175,8 +180,8 @@ class Renderer:
             self._draw_robot(img, disp, float(side), blur_px)
         cam = self.camera
         img = img * cam.gain[side] + cam.bias[side]
-        if cam.noise:
-            img += self.rng.normal(0.0, cam.noise, img.shape).astype(np.float32)
+        if self._noise is not None:
+            img += self._noise[int(self.rng.integers(len(self._noise)))]
         if cam.white:
             img = img[..., None] * np.asarray(cam.white[side], np.float32)
         lens = self._lens[side]

@@ -66,7 +66,7 @@ def trial_setup(seed: int, index: int, size: tuple[int, int], params: MatcherPar
     theta = math.radians(float(rng.uniform(-4, 4)))
     faults = WorldFaults() if nominal else random_faults(rng, target_z)
     return Setup(size, start, x, theta, boxes, faults, seed=int(rng.integers(1 << 30)),
-                 params=params, control=ControlConfig())
+                 params=params.replace(colour=False), control=ControlConfig())
 
 
 def _describe(f: WorldFaults) -> str:
