@@ -127,7 +127,8 @@ def find_markers(left: np.ndarray, right: np.ndarray, kind: str = "disc",
             found.append(find(img))
             continue
         x0, y0, x1, y1 = win
-        found.append([Blob(b.u + x0, b.v + y0, b.radius) for b in find(img[y0:y1, x0:x1])])
+        found.append([Blob(b.u + x0, b.v + y0, b.radius, b.aspect)
+                      for b in find(img[y0:y1, x0:x1])])
     pairs = []
     for a in found[0]:
         for b in found[1]:
