@@ -114,10 +114,14 @@ class Servo:
         self._last_capture: float | None = None
 
     def _frame(self) -> StereoFrame:
-        """The next pair, the right view brought to the left's exposure."""
         frame = self.source.read()
         if frame is None:
             raise CameraError("the camera ended")
+        return frame
+
+    @staticmethod
+    def _exposed(frame: StereoFrame) -> StereoFrame:
+        """The pair with the right view brought to the left's exposure."""
         return StereoFrame(frame.left, match_exposure(frame.left, frame.right), frame.t_left,
                            frame.t_right)
 
@@ -126,7 +130,7 @@ class Servo:
     def reference(self) -> Target:
         disps = []
         for _ in range(self.reference_frames):
-            f = self._frame()
+            f = self._exposed(self._frame())
             disps.append(compute_disparity(f.left, f.right, self.params))
             self.link.stop()  # keeps the link alive while the robot waits
         h, w = disps[0].shape
@@ -283,6 +287,7 @@ class Servo:
         last = self.rows[-1] if self.rows else None
         frame = self._frame()
         t_wall = time.perf_counter()
+        frame = self._exposed(frame)
         invalid = self._timing(frame)
         pair = find_marker(frame.left, frame.right, self.marker, self.marker_radius_m,
                            self.geometry.baseline_m, self.last_pair)
