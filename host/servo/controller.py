@@ -16,9 +16,12 @@ while the fitted error stays within tolerance_m and moves again beyond it.
 
 Turn: spin until the marker, lost edge-on, is seen again; the card's apparent aspect (width /
 height = |cos| of its angle) when it was lost and when it returned, and the time between, give
-the turn rate actually achieved; the spin goes on for the remaining angle at that rate. Then
-re-acquisition: driving waits for the marker. Sideways drift of the marker's position
-x = B (u - cx) / d from where it was first seen, and its rate, steer the robot back (PD).
+the turn rate actually achieved; the spin goes on for the remaining angle at that rate (an
+absence shorter than min_gap_s is a flicker, not the card's back). Then re-acquisition: driving
+waits for the marker; if the card never came back in the turn, the robot spins slowly on to
+find it.
+Sideways drift of the marker's position x = B (u - cx) / d from where it was first seen, and its
+rate, steer the robot back (PD).
 
 Safety: an invalid observation (no marker, stale or skewed frame) stops the robot at once;
 after lost_frames of them the phase is "lost" (stopped) until the marker returns.
@@ -31,8 +34,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-WAIT, HOLD, DRIVE, CREEP, TURN, LOST, STALE = ("wait", "hold", "drive", "creep", "turn",
-                                                "lost", "stale")
+WAIT, HOLD, DRIVE, CREEP, TURN, LOST, STALE, SEARCH = ("wait", "hold", "drive", "creep", "turn",
+                                                        "lost", "stale", "search")
 
 
 @dataclass(frozen=True)
@@ -51,6 +54,9 @@ class ControlConfig:
     mode: str = "turn"  # or "reverse"
     turn_duty: int = 400
     turn_timeout_s: float = 8.0
+    min_gap_s: float = 0.3  # the card is edge-on at least this long in a turn (a flicker is not)
+    search_duty: int = 300  # spin to find the marker again when it is lost after a turn
+    search_s: float = 8.0
     lost_frames: int = 3
 
 
@@ -92,6 +98,7 @@ class Controller:
         self.lateral_ref: float | None = None
         self.history: list[Observation] = []  # valid observations since the last turn
         self._turn: dict | None = None
+        self._search_until: float | None = None
 
     # ---------------------------------------------------------------------- estimates
 
@@ -128,9 +135,16 @@ class Controller:
             if not self.seen:
                 return self._stop(WAIT, None)
             # stopped at once; after lost_frames of them the marker is lost
-            return self._stop(LOST if self.missing > self.cfg.lost_frames else WAIT, None)
+            if self.missing <= self.cfg.lost_frames:
+                return self._stop(WAIT, None)
+            if self._search_until is not None and obs.t < self._search_until:
+                self.phase = SEARCH  # turned, but the card is not back: spin on to find it
+                d = self.cfg.search_duty
+                return Command(d, -d, SEARCH, None)
+            return self._stop(LOST, None)
         self.missing = 0
         self.seen = True
+        self._search_until = None
         if self.lateral_ref is None:
             self.lateral_ref = obs.lateral_m
         self.history.append(obs)
@@ -184,20 +198,20 @@ class Controller:
 
     def _turning(self, obs: Observation) -> Command:
         """Spin until the card, lost edge-on, comes back and has turned the remaining angle."""
-        turn = self._turn
+        turn, cfg = self._turn, self.cfg
         assert turn is not None
         seen = obs.depth_m is not None
         if turn["end"] is not None:
             if obs.t < turn["end"]:
                 return self._spin(None)
-            return self._end_turn()
+            return self._end_turn(obs.t)
         if obs.t - turn["t0"] > self.cfg.turn_timeout_s:
-            return self._end_turn()  # never came back: re-acquisition decides (lost)
+            return self._end_turn(obs.t, search=True)  # the card never came back: look for it
         if seen and turn["lost_t"] is None:
             turn["last_seen"] = (obs.t, obs.aspect)
         elif not seen and turn["lost_t"] is None and not obs.invalid:
             turn["lost_t"], turn["lost_aspect"] = turn["last_seen"]
-        elif seen and turn["lost_t"] is not None:
+        elif seen and turn["lost_t"] is not None and obs.t - turn["lost_t"] >= cfg.min_gap_s:
             a_lost = min(1.0, turn["lost_aspect"])
             a_now = min(1.0, obs.aspect)
             swept = math.pi - math.acos(a_lost) - math.acos(a_now)
@@ -205,11 +219,12 @@ class Controller:
             remaining = math.acos(a_now) / rate - self.cfg.stop_lead_s
             turn["end"] = obs.t + max(0.0, remaining)
             if remaining <= 0:
-                return self._end_turn()
+                return self._end_turn(obs.t)
         return self._spin(None)
 
-    def _end_turn(self) -> Command:
+    def _end_turn(self, t: float, search: bool = False) -> Command:
         self._turn = None
+        self._search_until = t + self.cfg.search_s if search else None
         self.facing_away = not self.facing_away
         self.history.clear()
         self.missing = 0
