@@ -85,3 +85,22 @@ def test_turn_ends_facing_back_with_a_weaker_right_motor() -> None:
     assert not ctl.facing_away
     assert abs(abs(plant.theta) - math.pi) < math.radians(20)
     assert ctl.phase == "hold" and abs(plant.z - 1.2) < 0.01
+
+
+def test_a_flicker_of_the_card_does_not_end_the_turn() -> None:
+    """The card seen again 0.1 s after it went edge-on is noise at the edge of detection, not
+    its other side: the turn goes on."""
+    ctl = Controller(1.2, ControlConfig())
+    t = 0.0
+    assert ctl.update(Observation(t, 2.0, 0.0, 1.0)).phase == "turn"
+    for aspect in (0.95, 0.85, 0.77):
+        t += 0.1
+        ctl.update(Observation(t, 2.0, 0.0, aspect))
+    t += 0.05
+    assert ctl.update(Observation(t, None)).phase == "turn"  # edge-on
+    t += 0.05
+    assert ctl.update(Observation(t, 2.0, 0.0, 0.76)).phase == "turn"  # a flicker
+    for _ in range(8):
+        t += 0.1
+        assert ctl.update(Observation(t, None)).phase == "turn"
+    assert ctl.facing_away
