@@ -35,6 +35,7 @@ class CameraFaults:
     drop: float = 0.0  # probability that a frame never arrives
     noise: float = 2.0  # sensor noise, grey levels (sigma)
     distortion: tuple[float, float] = (0.0, 0.0)  # radial k1 of the left and right lens
+    # (with distortion the simulated camera is calibrated on rendered chessboards first)
 
 
 @dataclass(frozen=True)

@@ -9,10 +9,12 @@ import math
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 
+from host.camera.calibration import Rectifier
 from host.emulator.emulator import Emulator, PtyService
 from host.link.client import RobotLink
 from host.servo.controller import ControlConfig
 from host.servo.loop import Servo
+from host.sim.chessboard import calibrate_camera
 from host.sim.faults import WorldFaults
 from host.sim.renderer import Renderer
 from host.sim.source import SimSource
@@ -77,8 +79,12 @@ def simulation(setup: Setup = Setup(), reference: bool = True) -> Iterator[SimRu
         source = SimSource(world, emulator, setup.fps, renderer=renderer, events=faults.events,
                            latency_ms=faults.motor.latency_ms + faults.link.delay_ms,
                            seed=setup.seed)
-        servo = Servo(source, link, setup.params, world.geometry, setup.control,
-                      clock=source.clock)
+        geometry = world.geometry
+        if any(faults.camera.distortion):  # rectify as a user would: with a calibration
+            calib = calibrate_camera(world, faults.camera, setup.seed)
+            source.rectify = Rectifier(calib)
+            geometry = calib.geometry
+        servo = Servo(source, link, setup.params, geometry, setup.control, clock=source.clock)
         run = SimRun(world, emulator, source, servo, link)
         if reference:
             servo.reference()

@@ -16,6 +16,7 @@ scene event), stops itself, or 45 s pass. Outcomes:
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import multiprocessing
@@ -65,6 +66,10 @@ def trial_setup(seed: int, index: int, size: tuple[int, int], params: MatcherPar
     x = float(rng.uniform(-0.04, 0.04)) * start
     theta = math.radians(float(rng.uniform(-4, 4)))
     faults = WorldFaults() if nominal else random_faults(rng, target_z)
+    if not nominal:  # lenses from a stream of their own: the other faults stay as they were
+        lens = np.random.default_rng([seed, index, 1]).uniform(-0.1, 0.04, 2)
+        faults = dataclasses.replace(faults, camera=dataclasses.replace(
+            faults.camera, distortion=(float(lens[0]), float(lens[1]))))
     return Setup(size, start, x, theta, boxes, faults, seed=int(rng.integers(1 << 30)),
                  params=params.replace(colour=False), control=ControlConfig())
 
