@@ -31,10 +31,11 @@ def _texture() -> tuple[np.ndarray, np.ndarray]:
     return img, np.array([[1 / PPM, 0, x0], [0, 1 / PPM, x0], [0, 0, 1]])
 
 
-def board_pairs(world: World, camera: CameraFaults, n: int = 14, seed: int = 0
+def board_pairs(world: World, camera: CameraFaults, n: int = 24, seed: int = 0
                 ) -> list[StereoFrame]:
-    """n pairs of a chessboard held at random poses 0.45-0.65 m in front of the camera, seen
-    through the lenses (the world's ideal geometry, then each side's radial distortion)."""
+    """n pairs of a chessboard held at random poses 0.4-0.65 m in front of the camera, over the
+    whole picture (corners and edges too, where distortion is largest), seen through the lenses
+    (the world's ideal geometry, then each side's radial distortion)."""
     g, (w, h) = world.geometry, world.size
     k = np.array([[g.focal_px, 0, g.cx], [0, g.focal_px, g.cy], [0, 0, 1]])
     tex, a = _texture()
@@ -45,7 +46,8 @@ def board_pairs(world: World, camera: CameraFaults, n: int = 14, seed: int = 0
     for _ in range(n):
         rvec = np.array([rng.uniform(-0.4, 0.4), rng.uniform(-0.4, 0.4), rng.uniform(-0.3, 0.3)])
         r = cv2.Rodrigues(rvec)[0]
-        centre = np.array([rng.uniform(-25, 25), rng.uniform(-20, 20), rng.uniform(450, 650)])
+        z = rng.uniform(400, 650)
+        centre = np.array([rng.uniform(-0.25, 0.25) * z, rng.uniform(-0.17, 0.17) * z, z])
         t = centre - r @ mid
         views = []
         for side, lens in enumerate(lenses):
