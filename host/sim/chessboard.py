@@ -7,7 +7,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from host.camera.calibration import Calibration, calibrate
+from host.camera.calibration import Calibration, calibrate, find_board
 from host.camera.source import StereoFrame
 from host.sim.faults import CameraFaults
 from host.sim.renderer import lens_maps
@@ -47,7 +47,7 @@ def board_pairs(world: World, camera: CameraFaults, n: int = 24, seed: int = 0
         rvec = np.array([rng.uniform(-0.4, 0.4), rng.uniform(-0.4, 0.4), rng.uniform(-0.3, 0.3)])
         r = cv2.Rodrigues(rvec)[0]
         z = rng.uniform(400, 650)
-        centre = np.array([rng.uniform(-0.25, 0.25) * z, rng.uniform(-0.17, 0.17) * z, z])
+        centre = np.array([rng.uniform(-0.2, 0.2) * z, rng.uniform(-0.12, 0.12) * z, z])
         t = centre - r @ mid
         views = []
         for side, lens in enumerate(lenses):
@@ -64,7 +64,18 @@ def board_pairs(world: World, camera: CameraFaults, n: int = 24, seed: int = 0
     return pairs
 
 
-def calibrate_camera(world: World, camera: CameraFaults, seed: int = 0) -> Calibration:
-    """The simulated camera calibrated by host.camera.calibration on rendered boards."""
-    calib, _ = calibrate(board_pairs(world, camera, seed=seed), BOARD, SQUARE_MM)
+def calibrate_camera(world: World, camera: CameraFaults, seed: int = 0,
+                     pairs: int = 18) -> Calibration:
+    """The simulated camera calibrated by host.camera.calibration on rendered boards: poses
+    are drawn until `pairs` of them show the whole board in both views, as a user keeps
+    showing the board until enough views are taken."""
+    found: list[StereoFrame] = []
+    for batch in range(8):
+        for frame in board_pairs(world, camera, seed=seed * 8 + batch):
+            if find_board(frame.left, BOARD) is not None and \
+                    find_board(frame.right, BOARD) is not None:
+                found.append(frame)
+        if len(found) >= pairs:
+            break
+    calib, _ = calibrate(found[:pairs], BOARD, SQUARE_MM)
     return calib
