@@ -1,7 +1,8 @@
 """Benchmark of the live view's cost to the servo loop: loop rate at 640x480 (or --size) with
 no view, with the view but no page, and with a page connected (a separate process that asks for
 updates as fast as they come, as a browser does), runs interleaved to show the noise; and the
-page's update rate and bytes per second. The emulator answers on a pty in real time.
+page's update rate and bytes per second. The simulated world and robot run in lockstep
+(host.sim.run), so the loop runs as fast as it can.
 
 On a shared machine the wall-clock rate follows the load more than anything; the CPU time the
 loop's own thread spends a step, and the whole process's (the view's threads included, the
@@ -18,12 +19,7 @@ import subprocess
 import sys
 import time
 
-from host.emulator.emulator import Emulator, PtyService
-from host.link.client import RobotLink
-from host.servo.controller import ControlConfig
-from host.servo.loop import Servo
-from host.servo.sim_source import SimSource
-from host.servo.world import World
+from host.sim.run import Setup, simulation
 from host.stereo import MatcherParams
 from host.stereo.matcher import warm_up
 from host.view import ViewFeed, ViewServer
@@ -31,13 +27,9 @@ from host.view import ViewFeed, ViewServer
 
 def measure(size: tuple[int, int], params: MatcherParams, frames: int, view: str) -> dict:
     """view: none, idle (server up, no page) or page."""
-    world = World.for_size(*size)
-    world.robot.z_m = 2.0
     page = None
-    with PtyService(Emulator(), realtime=True) as service, RobotLink(service.path) as link:
-        source = SimSource(world, Emulator(line_rate=False), reference_frames=3)
-        servo = Servo(source, link, params, world.geometry,
-                      ControlConfig(turn_s=world.motors.turn_seconds(ControlConfig.turn_duty)))
+    with simulation(Setup(size, 2.0, params=params), reference=False) as sim:
+        servo = sim.servo
         feed = server = None
         if view != "none":
             feed = ViewFeed()

@@ -12,37 +12,51 @@ import pytest
 
 from host.cli import main
 from host.commands.servo_outcome import NOT_REACHED, outcome
-from host.servo.loop import LogRow
+from host.servo.loop import LogRow, Servo
 
 
-def _row(t: float, phase: str, robot_px: float = math.nan) -> LogRow:
-    return LogRow(t, phase, 20.0, robot_px, robot_px, math.nan, 0, 0, 30.0, 1.0)
+def _row(t: float, phase: str, robot_px: float = math.nan, reason: str = "") -> LogRow:
+    depth = 25.0 / robot_px
+    return LogRow(t, phase, reason, 1.25, depth, depth - 1.25, 20.0, robot_px, robot_px, 0, 0,
+                  30.0, 1.0, 0.0)
 
 
-def _depth(d: float) -> float:
-    return 25.0 / d
+class _Run:
+    """What outcome() reads of a finished Servo."""
+
+    def __init__(self, rows: list[LogRow], requested_stop: str | None = None) -> None:
+        self.rows, self.requested_stop, self.target_m = rows, requested_stop, 1.25
+
+    def outcome(self) -> tuple[str, str]:
+        return Servo.outcome(self)  # type: ignore[arg-type]
 
 
-@pytest.mark.parametrize("rows, status, words", [
-    ([_row(0, "hold"), _row(1, "lost")], NOT_REACHED, "never seen in 2 frames"),
-    ([_row(0, "drive", 18.0), _row(1, "lost")], NOT_REACHED, "safe stop after 1.0 s: the "
-                                                              "marker was lost"),
-    ([_row(0, "drive", 18.0), _row(1, "stale")], NOT_REACHED, "too late"),
-    ([_row(0, "drive", 18.0), _row(1, "hold", 20.1)], 0, "held at disparity 20.10 px"),
-    ([_row(0, "drive", 18.0), _row(1, "drive", 19.0)], 0, "stopped while in phase drive"),
-    ([], NOT_REACHED, "before the robot phase"),
+@pytest.mark.parametrize("rows, stop, status, words", [
+    ([_row(0, "hold"), _row(1, "lost", reason="marker lost")], None, NOT_REACHED,
+     "never seen in 2 frames"),
+    ([_row(0, "drive", 18.0), _row(1, "lost", reason="marker lost")], None, NOT_REACHED,
+     "safe stop after 1.0 s: marker lost"),
+    ([_row(0, "drive", 18.0), _row(1, "stale", reason="stale")], None, NOT_REACHED, "stale"),
+    ([_row(0, "drive", 18.0), _row(1, "stop", 19.0, "target vanished")], None, NOT_REACHED,
+     "target vanished"),
+    ([_row(0, "drive", 18.0), _row(1, "hold", 20.1)], None, 0, "held at 1.244 m"),
+    ([_row(0, "drive", 18.0), _row(1, "drive", 19.0)], None, 0, "stopped while in phase drive"),
+    ([_row(0, "drive", 18.0), _row(1, "stop", 19.0, "pressed")], "pressed", 0,
+     "stopped (pressed)"),
+    ([], None, NOT_REACHED, "before the robot phase"),
 ])
-def test_outcome_of_a_run(rows: list[LogRow], status: int, words: str) -> None:
-    got, message = outcome(rows, _depth)
+def test_outcome_of_a_run(rows: list[LogRow], stop: str | None, status: int, words: str) -> None:
+    got, message = outcome(_Run(rows, stop))  # type: ignore[arg-type]
     assert got == status and words in message and "nan" not in message
 
 
 def test_a_replay_without_the_marker_exits_3_with_the_reason(tmp_path: Path, capsys) -> None:
-    from host.servo.world import World
+    from host.sim.renderer import Renderer
+    from host.sim.world import World
 
-    world = World.for_size(320, 240)
+    renderer = Renderer(World.for_size(320, 240))
     for i in range(8):  # five reference frames, then three in which no robot appears
-        frame, _ = world.render(i / 30, with_robot=False)
+        frame = renderer.frame(with_robot=False)
         cv2.imwrite(str(tmp_path / f"left_{i:03d}.png"), frame.left)
         cv2.imwrite(str(tmp_path / f"right_{i:03d}.png"), frame.right)
     log = tmp_path / "run.csv"

@@ -14,8 +14,11 @@ from host.camera.calibration import Calibration, Geometry
 from host.camera.open import add_camera_options, open_source, parse_size
 from host.camera.source import CameraError
 from host.commands.options import (
+    COUNT,
+    FRACTION,
     NON_NEGATIVE,
     POSITIVE,
+    SEED,
     add_matcher_options,
     float_range,
     int_range,
@@ -49,11 +52,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--settle", type=NON_NEGATIVE, default=1.0, metavar="S",
                    help="end after holding at the target this long (0: run on)")
     p.add_argument("--tolerance-cm", type=POSITIVE, default=1.0,
-                   help="stop within this depth of the target (converted to px there)")
+                   help="hold within this depth of the target (widened, and said so, when below "
+                        "the depth noise measured there)")
     p.add_argument("--mode", choices=("turn", "reverse"), default="turn",
                    help="to come back: turn round and drive (the paper) or reverse")
-    p.add_argument("--turn-s", type=POSITIVE, help="seconds a turn round takes (default: the "
-                                                "simulated robot's, 2 s on a real one)")
     p.add_argument("--max-duty", type=int_range(1, 1000), default=600,
                    help="largest duty while driving (permille)")
     p.add_argument("--min-duty", type=int_range(0, 1000), default=180,
@@ -65,6 +67,22 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--start-depth", type=float_range(0.3, 3.0), default=1.9,
                    help="sim: robot's start (m)")
     p.add_argument("--fps", type=float_range(1, 1000), default=30.0, help="sim: frame rate")
+    p.add_argument("--faults", action="store_true",
+                   help="sim: a world that fails like hardware (random faults from --seed)")
+    p.add_argument("--seed", type=SEED, default=0, help="sim: seed of the world and its faults")
+    p.add_argument("--trials", type=COUNT, metavar="N",
+                   help="sim: N randomized runs of the faulty world, then their summary")
+    p.add_argument("--json", type=Path, metavar="trials.json",
+                   help="with --trials: write every trial and the summary")
+    p.add_argument("--nominal", action="store_true",
+                   help="with --trials: the world without faults")
+    p.add_argument("--workers", type=COUNT, default=2, help="with --trials: processes")
+    p.add_argument("--drop", type=FRACTION, default=0.0, help="sim: byte drop probability")
+    p.add_argument("--corrupt", type=FRACTION, default=0.0,
+                   help="sim: byte corruption probability")
+    p.add_argument("--delay-ms", type=NON_NEGATIVE, default=0.0, help="sim: line delay (ms)")
+    p.add_argument("--silent-after", type=NON_NEGATIVE, metavar="MS",
+                   help="sim: the robot goes silent after MS ms")
     add_camera_options(p, sim=True)
     add_matcher_options(p)
     add_view_option(p)
@@ -83,11 +101,11 @@ class _Status:
         if not self.tty or now - self._last < 0.1:
             return
         self._last = now
-        robot = f"{row.robot_px:6.2f}" if math.isfinite(row.robot_px) else "   ---"
-        err = f"{row.error_px:+6.2f}" if math.isfinite(row.error_px) else "   ---"
+        robot = f"{row.depth_m:6.3f}" if math.isfinite(row.depth_m) else "   ---"
+        err = f"{row.error_m * 100:+6.1f}" if math.isfinite(row.error_m) else "   ---"
         hz = f"{row.loop_hz:5.1f}" if math.isfinite(row.loop_hz) else "  ---"
-        sys.stderr.write(f"\r{row.t:7.2f} s  {row.phase:<5}  target {row.target_px:6.2f} px  "
-                         f"robot {robot} px  error {err}  cmd {row.left:5d} {row.right:5d}  "
+        sys.stderr.write(f"\r{row.t:7.2f} s  {row.phase:<7}  target {row.target_m:6.3f} m  "
+                         f"robot {robot} m  error {err} cm  cmd {row.left:5d} {row.right:5d}  "
                          f"{hz} Hz ")
         sys.stderr.flush()
 
@@ -106,33 +124,71 @@ def run(args: argparse.Namespace) -> int:
         check_output(args.plot, "png", "--plot")
     if args.min_duty > args.max_duty:
         raise HostError(f"--min-duty {args.min_duty} exceeds --max-duty {args.max_duty}")
-    if args.sim:
-        args.camera, args.port = "sim", args.port or "emulator"
+    if args.sim or args.camera == "sim":
+        if args.port not in (None, "emulator"):
+            raise HostError("--camera sim needs --port emulator (the simulated robot)")
+        return _run_sim(args)
+    if args.trials or args.faults:
+        raise HostError("--trials and --faults need --sim")
     if not args.port:
         raise HostError("--port is needed (a serial port, or 'emulator'); --sim runs it all "
                         "simulated")
-    if args.camera == "sim" and args.port != "emulator":
-        raise HostError("--camera sim needs --port emulator (the simulated robot)")
     params = params_from_args(args)
     with contextlib.ExitStack() as stack:
-        emulator, service = None, None
-        if args.sim and args.robot != "emulator":
-            emulator = service = stack.enter_context(_avr_board(args))
-        elif args.port == "emulator":
+        service = None
+        if args.port == "emulator":
             from host.emulator.emulator import Emulator, PtyService
 
-            emulator = Emulator(line_rate=args.camera != "sim")
-            service = stack.enter_context(PtyService(emulator, realtime=args.camera != "sim"))
+            service = stack.enter_context(PtyService(Emulator(_link_faults(args))))
         # the port first: a wrong one fails before a camera is opened
         link = stack.enter_context(RobotLink(service.path if service else args.port))
-        if args.camera == "sim":
-            source, world, geometry, clock = _sim(args, emulator)
-        else:
-            source = stack.enter_context(open_source(args))
-            world, clock = None, time.monotonic
-            geometry = (Calibration.load(args.calib).geometry if args.calib
-                        else Geometry.minoru_default(*parse_size(args.size)))
-        return _servo(args, params, source, link, geometry, world, clock)
+        source = stack.enter_context(open_source(args))
+        geometry = (Calibration.load(args.calib).geometry if args.calib
+                    else Geometry.minoru_default(*parse_size(args.size)))
+        servo = Servo(source, link, params, geometry, _control(args), marker=args.marker,
+                      marker_radius_m=args.marker_radius_cm / 100 if args.marker_radius_cm
+                      else None)
+        return _servo(args, servo, geometry, None, time.monotonic)
+
+
+def _link_faults(args):
+    from host.emulator.emulator import Faults
+
+    return Faults(drop=args.drop, corrupt=args.corrupt, delay_ms=args.delay_ms,
+                  silent_after_ms=args.silent_after, seed=args.seed)
+
+
+def _control(args) -> ControlConfig:
+    return ControlConfig(tolerance_m=args.tolerance_cm / 100, max_duty=args.max_duty,
+                         min_duty=args.min_duty, mode=args.mode)
+
+
+def _run_sim(args) -> int:
+    import dataclasses
+
+    import numpy as np
+
+    from host.sim.faults import WorldFaults, random_faults
+    from host.sim.run import Setup, simulation
+
+    params = params_from_args(args)
+    if args.trials:
+        from host.sim.trials import run_trials
+
+        return run_trials(args.trials, args.seed, parse_size(args.size), params, args.json,
+                          workers=args.workers, nominal=args.nominal)
+    faults = WorldFaults()
+    if args.faults:
+        faults = random_faults(np.random.default_rng(args.seed), 1.2)
+    link = _link_faults(args)
+    if link != type(link)(seed=args.seed):
+        faults = dataclasses.replace(faults, link=link)
+    with contextlib.ExitStack() as stack:
+        board = None if args.robot == "emulator" else stack.enter_context(_avr_board(args))
+        setup = Setup(parse_size(args.size), args.start_depth, faults=faults, seed=args.seed,
+                      fps=args.fps, params=params, control=_control(args), board=board)
+        sim = stack.enter_context(simulation(setup, reference=False))
+        return _servo(args, sim.servo, sim.servo.geometry, sim.world, sim.source.clock)
 
 
 def _avr_board(args):
@@ -150,40 +206,19 @@ def _avr_board(args):
 
     out = build.ROOT / "build" / "simavr"
     out.mkdir(parents=True, exist_ok=True)
-    harness = build.simavr_harness(out)
-    return SimavrPty(harness, build.firmware_elf())
+    return SimavrPty(build.simavr_harness(out), build.firmware_elf())
 
 
-def _sim(args, emulator):
-    from host.servo.sim_source import SimSource
-    from host.servo.world import World
-
-    w, h = parse_size(args.size)
-    world = World.for_size(w, h)
-    world.robot.z_m = args.start_depth
-    source = SimSource(world, emulator, args.fps)
-    return source, world, world.geometry, source.clock
-
-
-def _servo(args, params, source, link, geometry, world, clock) -> int:
-    turn_s = args.turn_s or (world.motors.turn_seconds(ControlConfig.turn_duty) if world
-                             else 2.0)
-    servo = Servo(source, link, params, geometry, ControlConfig(
-        max_duty=args.max_duty, min_duty=args.min_duty, mode=args.mode, turn_s=turn_s),
-        marker=args.marker, clock=clock,
-        marker_radius_m=args.marker_radius_cm / 100 if args.marker_radius_cm else None,
-        tolerance_m=args.tolerance_cm / 100)
+def _servo(args, servo, geometry, world, clock) -> int:
     with open_view(args.view, servo):
-        return _run_servo(args, servo, link, geometry, world, clock)
+        return _run_servo(args, servo, geometry, world, clock)
 
 
-def _run_servo(args, servo, link, geometry, world, clock) -> int:
+def _run_servo(args, servo, geometry, world, clock) -> int:
     target = servo.reference()
     z = geometry.depth_m(target.disparity)
-    tol = servo.control.tolerance_px
     print(f"target: nearest object at disparity {target.disparity:.2f} px ({z:.3f} m), "
-          f"{target.area} px; tolerance {tol:.3f} px = {args.tolerance_cm:g} cm there",
-          file=sys.stderr)
+          f"{target.area} px; tolerance {servo.tolerance_m * 100:g} cm", file=sys.stderr)
     status = _Status()
     t0 = clock()
     try:
@@ -194,8 +229,11 @@ def _run_servo(args, servo, link, geometry, world, clock) -> int:
                 if not args.camera.startswith("replay:"):
                     raise
                 break  # the end of a replay ends the run; outcome() tells how it went
+            for note in servo.notes:
+                print(f"note: {note}", file=sys.stderr)
+            servo.notes.clear()
             status.show(row)
-            if row.phase == "stopped":  # STOP pressed in the view
+            if row.phase == "stop":  # the servo's own safe stop, or STOP pressed in the view
                 break
             if args.duration is not None and clock() - t0 >= args.duration:
                 break
@@ -210,14 +248,14 @@ def _run_servo(args, servo, link, geometry, world, clock) -> int:
                 write_csv(args.log, servo.rows)
             if args.plot:
                 plot_run(args.plot, servo.rows, geometry)
-    failed, msg = outcome(servo.rows, geometry.depth_m, servo.stop_reason)
+    failed, msg = outcome(servo)
     if world is not None:
         msg += (f"; true robot depth {world.robot.z_m:.3f} m, nearest box "
                 f"{world.nearest_box().z_m:.3f} m")
     if failed:
         raise NotReached(msg)
     print(msg, file=sys.stderr)
-    if servo.stop_reason is not None:
-        robot = link.status()
+    if servo.requested_stop:
+        robot = servo.link.status()
         print(f"the robot reports duty {robot.left} {robot.right} after STOP", file=sys.stderr)
     return 0

@@ -1,41 +1,39 @@
 """How a servo run ended, as the exit status and one line: held at the target (0), stopped by
---duration or a replay's end while moving (0), or not reached (NOT_REACHED): the marker was
-never seen, or the run ended in a safe stop (marker lost, frames too late)."""
+the user (the view's STOP), --duration or a replay's end (0), or not reached (NOT_REACHED): the
+marker was never seen, or the run ended in a safe stop (marker lost, frames too late, target
+vanished)."""
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
 
 from host.errors import NotReached
+from host.servo.loop import Servo
 
 NOT_REACHED = NotReached.status  # the run ended without the robot holding at the target
 
-_SAFE_STOPS = {"lost": "the marker was lost", "stale": "frames came too late (stale)",
-               "hold": "the marker was not seen in the last frame"}
 
-
-def outcome(rows: Sequence, depth_m: Callable[[float], float],
-            stop_reason: str | None = None) -> tuple[int, str]:
-    """(exit status, message) for the log rows of a run; depth_m turns disparity into metres;
-    stop_reason is why the user stopped the run (the view's STOP), which is no failure."""
+def outcome(servo: Servo) -> tuple[int, str]:
+    """(exit status, message) for a finished run."""
+    rows = servo.rows
     if not rows:
         return NOT_REACHED, "the run ended before the robot phase began"
-    target = rows[0].target_px
-    if not any(math.isfinite(r.robot_px) for r in rows):
+    seen = [r for r in rows if math.isfinite(r.robot_px)]
+    if not seen:
         return NOT_REACHED, (f"the marker was never seen in {len(rows)} frames (check --marker "
                              f"and that the robot's marker faces the cameras)")
     last = rows[-1]
     after = f"after {last.t - rows[0].t:.1f} s"
-    seen = [r for r in rows if math.isfinite(r.robot_px)][-1]
-    if last.phase in _SAFE_STOPS and not math.isfinite(last.robot_px):
-        return NOT_REACHED, (f"safe stop {after}: {_SAFE_STOPS[last.phase]}; last seen at "
-                             f"disparity {seen.robot_px:.2f} px ({depth_m(seen.robot_px):.3f} m) "
-                             f"against the target's {target:.2f} px")
-    where = (f"disparity {last.robot_px:.2f} px ({depth_m(last.robot_px):.3f} m) against the "
-             f"target's {target:.2f} px {after}")
-    if stop_reason is not None:
-        return 0, f"stopped ({stop_reason}) at {where}"
-    if last.phase == "hold":
-        return 0, f"held at {where}"
-    return 0, f"stopped while in phase {last.phase} at {where}"
+    target = f"the target's {servo.target_m:.3f} m"
+    held, reason = servo.outcome()
+    if held == "held":
+        return 0, (f"held at {last.depth_m:.3f} m (disparity {last.robot_px:.2f} px) against "
+                   f"{target} {after}")
+    if servo.requested_stop:
+        return 0, f"stopped ({servo.requested_stop}) {after}"
+    if last.reason:
+        return NOT_REACHED, (f"safe stop {after}: {reason}; last seen at {seen[-1].depth_m:.3f} m "
+                             f"(disparity {seen[-1].robot_px:.2f} px) against {target}")
+    where = (f"{last.depth_m:.3f} m" if math.isfinite(last.depth_m)
+             else f"last seen at {seen[-1].depth_m:.3f} m")
+    return 0, f"stopped while in phase {last.phase} at {where}, against {target} {after}"

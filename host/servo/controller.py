@@ -1,52 +1,75 @@
-"""The disparity-equalising control law: a pure state machine, one call per frame.
+"""The depth-equalising control law, in metres: a pure state machine, one call per frame.
 
-Error e = robot disparity - target disparity (px). e > 0: the robot is nearer than the object
-and must move away from the camera; e < 0: it is farther and must come back. The robot starts
-facing away from the camera. Moving in the direction it faces, it drives forward; otherwise it
-turns round in place (mode "turn", as in the paper; timed, turn_s at turn_duty) or reverses
-(mode "reverse").
+Error e = robot depth - target depth (m, from the calibrated geometry Z = f B / d). e < 0: the
+robot is nearer than the object and must move away from the camera; e > 0: it must come back.
+The robot starts facing away from the camera. Moving the way it faces, it drives forward;
+otherwise it turns round in place (mode "turn", as in the paper) or reverses ("reverse").
 
-Speed is proportional to |e| (gain permille per px) between min_duty (against stiction) and
-max_duty. Within tolerance_px it stops and holds; it moves again only when |e| exceeds
-resume_factor * tolerance_px (hysteresis, so it does not chatter at the edge). The marker's
-sideways position, x = B (u - cx) / d from its column u and disparity d, against where the
-servo first saw it, adds a small differential correction (steer_gain permille per cm) so the
-robot keeps to its line; using x rather than the bare column keeps perspective out of it.
+Depth and its rate come from a straight-line fit over the last fit_frames observations (noise
+averaged, speed measured). Speed: duty = floor + gain(z) |e| up to max_duty, gain scheduled with
+depth (gain_per_m * ref_depth_m / z: depth noise grows as z^2, so far away the law is gentler).
+The floor starts at min_duty and rises by creep_step whenever the robot is commanded but does
+not move (stiction, a weak motor, a sagging battery). Near the target the robot creeps, and it
+stops when the error predicted stop_lead_s ahead (measured speed times the stopping lag) reaches
+zero, from either side: the hold is centred on zero error, not on the edge of a band. It holds
+while the fitted error stays within tolerance_m and moves again beyond it.
 
-Safety: a frame without the marker stops the robot at once (hold); after more than lost_frames
-such frames the phase is "lost" and stays stopped until the marker is seen again. While turning
-the marker is edge-on and unseen: the turn goes on, timed, and the count starts after it.
+Turn: spin until the marker, lost edge-on, is seen again; the card's apparent aspect (width /
+height = |cos| of its angle) when it was lost and when it returned, and the time between, give
+the turn rate actually achieved; the spin goes on for the remaining angle at that rate (an
+absence shorter than min_gap_s is a flicker, not the card's back). Then re-acquisition: driving
+waits for the marker; if the card never came back in the turn, the robot spins slowly on to
+find it.
+Sideways drift of the marker's position x = B (u - cx) / d from where it was first seen, and its
+rate, steer the robot back (PD).
+
+Safety: an invalid observation (no marker, stale or skewed frame) stops the robot at once;
+after lost_frames of them the phase is "lost" (stopped) until the marker returns.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
-HOLD, DRIVE, TURN, LOST = "hold", "drive", "turn", "lost"
+import numpy as np
+
+WAIT, HOLD, DRIVE, CREEP, TURN, LOST, STALE, SEARCH = ("wait", "hold", "drive", "creep", "turn",
+                                                        "lost", "stale", "search")
 
 
 @dataclass(frozen=True)
 class ControlConfig:
-    tolerance_px: float = 0.25
-    resume_factor: float = 2.0
-    gain: float = 160.0  # permille per px of error
+    tolerance_m: float = 0.01
+    gain_per_m: float = 1500.0  # permille per m of error at ref_depth_m
+    ref_depth_m: float = 1.0
     min_duty: int = 180
     max_duty: int = 600
+    creep_m: float = 0.04  # within this error: the least duty that moves the robot
+    creep_step: int = 15  # permille added to the floor per still frame while creeping
+    stop_lead_s: float = 0.15  # stopping lag: actuation latency plus the wheels' run-down
+    fit_frames: int = 6
     steer_gain: float = 25.0  # permille per cm of sideways drift
+    steer_damping: float = 60.0  # permille per cm/s of sideways drift rate
     mode: str = "turn"  # or "reverse"
     turn_duty: int = 400
-    turn_s: float = 2.0
+    turn_timeout_s: float = 8.0
+    min_gap_s: float = 0.3  # the card is edge-on at least this long in a turn (a flicker is not)
+    search_duty: int = 300  # spin to find the marker again when it is lost after a turn
+    search_s: float = 8.0
     lost_frames: int = 3
 
 
 @dataclass(frozen=True)
 class Observation:
-    """What perception saw in one frame: the marker's disparity and sideways position, or
-    nothing (disparity None)."""
+    """What perception made of one frame: the marker's depth (m) and sideways position (m), its
+    aspect (width / height), at the frame's capture time; depth None = no valid marker."""
 
-    t: float  # s
-    disparity: float | None
+    t: float  # s, capture time
+    depth_m: float | None
     lateral_m: float | None = None
+    aspect: float = 1.0
+    invalid: str = ""  # why the frame is not usable ("stale", "skew"), "" if it is
 
 
 @dataclass(frozen=True)
@@ -54,7 +77,7 @@ class Command:
     left: int
     right: int
     phase: str
-    error: float | None
+    error_m: float | None
 
     @property
     def is_stop(self) -> bool:
@@ -62,55 +85,147 @@ class Command:
 
 
 class Controller:
-    def __init__(self, target_px: float, config: ControlConfig = ControlConfig()) -> None:
+    def __init__(self, target_m: float, config: ControlConfig = ControlConfig()) -> None:
         if config.mode not in ("turn", "reverse"):
             raise ValueError(f"mode must be turn or reverse, got {config.mode!r}")
-        self.target = target_px
+        self.target_m = target_m
         self.cfg = config
         self.facing_away = True
-        self.phase = HOLD
-        self.holding = False  # inside the tolerance band (with hysteresis)
+        self.phase = WAIT
+        self.seen = False
         self.missing = 0
+        self.floor = config.min_duty
         self.lateral_ref: float | None = None
-        self._turn_end: float | None = None
+        self.history: list[Observation] = []  # valid observations since the last turn
+        self._turn: dict | None = None
+        self._search_until: float | None = None
+
+    # ---------------------------------------------------------------------- estimates
+
+    def fit(self) -> tuple[float, float, float] | None:
+        """(depth now, depth rate m/s, lateral rate m/s) from the recent valid observations."""
+        h = self.history[-self.cfg.fit_frames:]
+        h = [o for o in h if h[-1].t - o.t <= 0.5]
+        if not h:
+            return None
+        if len(h) < 3:
+            return h[-1].depth_m or 0.0, 0.0, 0.0
+        t = np.array([o.t for o in h]) - h[-1].t
+        z = np.array([o.depth_m for o in h])
+        zs, z0 = np.polyfit(t, z, 1)
+        xs = 0.0
+        lat = [o.lateral_m for o in h]
+        if all(x is not None for x in lat):
+            xs = float(np.polyfit(t, np.array(lat, float), 1)[0])
+        return float(z0), float(zs), xs
 
     def _stop(self, phase: str, error: float | None) -> Command:
         self.phase = phase
         return Command(0, 0, phase, error)
 
+    # ------------------------------------------------------------------------- update
+
     def update(self, obs: Observation) -> Command:
-        cfg = self.cfg
-        if self._turn_end is not None:
-            if obs.t < self._turn_end:
-                self.phase = TURN
-                return Command(cfg.turn_duty, -cfg.turn_duty, TURN, None)
-            self._turn_end = None
-            self.facing_away = not self.facing_away
-            self.missing = 0
-        if obs.disparity is None:
+        if self._turn is not None:
+            return self._turning(obs)
+        if obs.depth_m is None:
             self.missing += 1
-            return self._stop(LOST if self.missing > cfg.lost_frames else HOLD, None)
+            if obs.invalid:
+                return self._stop(STALE, None)
+            if not self.seen:
+                return self._stop(WAIT, None)
+            # stopped at once; after lost_frames of them the marker is lost
+            if self.missing <= self.cfg.lost_frames:
+                return self._stop(WAIT, None)
+            if self._search_until is not None and obs.t < self._search_until:
+                self.phase = SEARCH  # turned, but the card is not back: spin on to find it
+                d = self.cfg.search_duty
+                return Command(d, -d, SEARCH, None)
+            return self._stop(LOST, None)
         self.missing = 0
+        self.seen = True
+        self._search_until = None
         if self.lateral_ref is None:
             self.lateral_ref = obs.lateral_m
-        e = obs.disparity - self.target
-        band = cfg.tolerance_px * (cfg.resume_factor if self.holding else 1.0)
-        self.holding = abs(e) <= band
-        if self.holding:
+        self.history.append(obs)
+        del self.history[:-30]
+        return self._drive(obs)
+
+    def _drive(self, obs: Observation) -> Command:
+        cfg = self.cfg
+        z, zdot, xdot = self.fit() or (obs.depth_m or 0.0, 0.0, 0.0)
+        e = z - self.target_m
+        away = e < 0
+        if self.phase == HOLD and abs(e) <= cfg.tolerance_m:
             return self._stop(HOLD, e)
-        away = e > 0  # the robot must move away from the camera
+        moving_in = self.phase in (DRIVE, CREEP)
+        predicted = e + zdot * cfg.stop_lead_s
+        if moving_in and (predicted * e <= 0 or abs(predicted) < 0.1 * cfg.tolerance_m):
+            return self._stop(HOLD, e)  # reached zero error (from either side): stop there
+        if not moving_in and abs(e) <= 0.25 * cfg.tolerance_m:
+            return self._stop(HOLD, e)
         forward = away == self.facing_away
         if not forward and cfg.mode == "turn":
-            self._turn_end = obs.t + cfg.turn_s
-            self.phase = TURN
-            return Command(cfg.turn_duty, -cfg.turn_duty, TURN, e)
-        duty = min(cfg.max_duty, max(cfg.min_duty, int(round(cfg.gain * abs(e)))))
+            return self._start_turn(obs, e)
+        creeping = abs(e) <= cfg.creep_m
+        if creeping and self.phase == CREEP and abs(zdot) < 0.004:
+            self.floor = min(cfg.max_duty // 2 + 100, self.floor + cfg.creep_step)
+        gain = cfg.gain_per_m * cfg.ref_depth_m / max(z, 0.3)
+        duty = self.floor if creeping else min(cfg.max_duty, int(self.floor + gain * abs(e)))
         duty = duty if forward else -duty
         steer = 0.0
         if obs.lateral_m is not None and self.lateral_ref is not None:
             # x' = v sin(theta): to cancel a drift to the right, turn so that v cos(theta) * dtheta
             # is negative; v cos(theta) is positive exactly when moving away from the camera
             s = 1.0 if away else -1.0
-            steer = s * cfg.steer_gain * 100 * (obs.lateral_m - self.lateral_ref) / 2
-        self.phase = DRIVE
-        return Command(int(round(duty - steer)), int(round(duty + steer)), DRIVE, e)
+            drift = obs.lateral_m - self.lateral_ref
+            steer = s * (cfg.steer_gain * 100 * drift + cfg.steer_damping * 100 * xdot) / 2
+            steer = max(-abs(duty) * 0.6, min(abs(duty) * 0.6, steer))
+        self.phase = CREEP if creeping else DRIVE
+        return Command(int(round(duty - steer)), int(round(duty + steer)), self.phase, e)
+
+    # --------------------------------------------------------------------------- turn
+
+    def _start_turn(self, obs: Observation, e: float) -> Command:
+        self._turn = {"t0": obs.t, "lost_t": None, "lost_aspect": 1.0, "end": None,
+                      "last_seen": (obs.t, obs.aspect)}
+        return self._spin(e)
+
+    def _spin(self, e: float | None) -> Command:
+        self.phase = TURN
+        d = self.cfg.turn_duty
+        return Command(d, -d, TURN, e)
+
+    def _turning(self, obs: Observation) -> Command:
+        """Spin until the card, lost edge-on, comes back and has turned the remaining angle."""
+        turn, cfg = self._turn, self.cfg
+        assert turn is not None
+        seen = obs.depth_m is not None
+        if turn["end"] is not None:
+            if obs.t < turn["end"]:
+                return self._spin(None)
+            return self._end_turn(obs.t)
+        if obs.t - turn["t0"] > self.cfg.turn_timeout_s:
+            return self._end_turn(obs.t, search=True)  # the card never came back: look for it
+        if seen and turn["lost_t"] is None:
+            turn["last_seen"] = (obs.t, obs.aspect)
+        elif not seen and turn["lost_t"] is None and not obs.invalid:
+            turn["lost_t"], turn["lost_aspect"] = turn["last_seen"]
+        elif seen and turn["lost_t"] is not None and obs.t - turn["lost_t"] >= cfg.min_gap_s:
+            a_lost = min(1.0, turn["lost_aspect"])
+            a_now = min(1.0, obs.aspect)
+            swept = math.pi - math.acos(a_lost) - math.acos(a_now)
+            rate = swept / max(obs.t - turn["lost_t"], 1e-3)
+            remaining = math.acos(a_now) / rate - self.cfg.stop_lead_s
+            turn["end"] = obs.t + max(0.0, remaining)
+            if remaining <= 0:
+                return self._end_turn(obs.t)
+        return self._spin(None)
+
+    def _end_turn(self, t: float, search: bool = False) -> Command:
+        self._turn = None
+        self._search_until = t + self.cfg.search_s if search else None
+        self.facing_away = not self.facing_away
+        self.history.clear()
+        self.missing = 0
+        return self._stop(WAIT, None)

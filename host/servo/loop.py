@@ -2,26 +2,46 @@
 
     reference phase: several frames of the scene without the robot -> the nearest object's
                      disparity is the target
-    robot phase:     each frame -> the marker's disparity (cross-checked by block matching over
-                     the marker: a pair that disagrees by more than max_mismatch_px is not the
-                     marker) -> Controller -> SET_DRIVE or STOP over the link
+    noise phase:     the robot stands while noise_frames frames measure the marker's disparity
+                     noise; a tolerance below the depth noise this gives at the target is widened
+                     to it, and the servo says so (notes)
+    robot phase:     each frame -> the marker's disparity, cross-checked by block matching over
+                     the marker with the search range set around it (min-disp / num-disp follow
+                     the marker, so near range is not cut off) -> depth (m) -> Controller ->
+                     SET_DRIVE or STOP over the link
+    every remeasure_s the target is measured again outside the robot's own image region: it
+    follows the object when it moves, retargets when a nearer object appears, and the run stops
+    ("target vanished") when nothing is left where it was.
 
-Any exception leaves through the link's context manager, which sends STOP.
+Time comes from the frames' capture timestamps: a frame whose capture follows the previous one by
+more than stale_s, or that arrives stale_s later than frames usually do, is stale; a pair whose
+two captures differ by more than max_skew_s is unusable, and a smaller skew is corrected with the
+marker's measured image speed. Any exception leaves through the link's context manager, which
+sends STOP.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
+import numpy as np
+
 from host.camera.calibration import Geometry
-from host.camera.source import CameraError, StereoSource
+from host.camera.source import CameraError, StereoFrame, StereoSource
+from host.errors import HostError
 from host.servo.controller import Command, ControlConfig, Controller, Observation
-from host.servo.marker import block_disparity, find_marker
-from host.servo.perception import Target, reference_target
+from host.servo.marker import MarkerPair, block_disparity, find_marker
+from host.servo.perception import (
+    Floor,
+    Target,
+    match_exposure,
+    nearest_object,
+    reference_target,
+    without_floor,
+)
 from host.servo.snapshot import Observer, Snapshot, link_stats
 from host.stereo.matcher import compute_disparity
 from host.stereo.params import MatcherParams
@@ -29,26 +49,43 @@ from host.stereo.params import MatcherParams
 
 @dataclass
 class LogRow:
-    t: float  # s, the loop's clock
+    t: float  # s, capture time of the frame (left sensor)
     phase: str
+    reason: str  # why the robot is stopped when it is ("" while it moves or holds)
+    target_m: float
+    depth_m: float  # the marker's depth, NaN when not seen
+    error_m: float
     target_px: float
     robot_px: float  # NaN when the marker was not seen
     block_px: float  # block-matching disparity over the marker (cross-check), NaN if none
-    error_px: float
     left: int
     right: int
     loop_hz: float
     latency_ms: float  # frame arrival to command acknowledged, wall time
+    skew_ms: float  # right capture minus left capture
     truth_depth_m: float = math.nan  # simulation only
+
+
+@dataclass
+class Step:
+    """Everything one step saw and decided: for logs, plots and live views."""
+
+    frame: StereoFrame  # the rectified pair
+    disparity: np.ndarray | None  # the disparity computed this step (band or map), if any
+    disparity_rows: tuple[int, int]  # the rows of the frame that disparity covers
+    target: Target
+    marker: MarkerPair | None
+    row: LogRow
 
 
 class Servo:
     def __init__(self, source: StereoSource, link, params: MatcherParams, geometry: Geometry,
                  control: ControlConfig = ControlConfig(), marker: str = "disc",
-                 reference_frames: int = 5, min_area: int | None = None, stale_s: float = 0.5,
+                 reference_frames: int = 5, min_area: int | None = None, stale_s: float = 0.3,
                  clock: Callable[[], float] = time.monotonic, full_map: bool = False,
                  max_mismatch_px: float = 1.5, marker_radius_m: float | None = 0.03,
-                 tolerance_m: float | None = None) -> None:
+                 max_skew_s: float = 0.045, remeasure_s: float = 1.0, noise_frames: int = 8,
+                 robot_half_width_m: float = 0.12, robot_below_marker_m: float = 0.22) -> None:
         self.source, self.link, self.params = source, link, params
         self.geometry, self.control, self.marker = geometry, control, marker
         self.reference_frames, self.stale_s, self.clock = reference_frames, stale_s, clock
@@ -56,103 +93,265 @@ class Servo:
         self.full_map = full_map
         self.max_mismatch_px = max_mismatch_px
         self.marker_radius_m = marker_radius_m  # the disc's radius on the card; None: unknown
-        self.tolerance_m = tolerance_m  # hold band in depth; None: control.tolerance_px as is
-        self.last_pair = None
-        self._map: tuple = (None, 0)  # the disparity this step computed, and its first row
+        self.max_skew_s, self.remeasure_s, self.noise_frames = max_skew_s, remeasure_s, noise_frames
+        self.robot_half_width_m, self.robot_below_marker_m = robot_half_width_m, \
+            robot_below_marker_m
+        self.last_pair: MarkerPair | None = None
         self.target: Target | None = None
+        self.floor: Floor | None = None
         self.controller: Controller | None = None
         self.rows: list[LogRow] = []
+        self.last: Step | None = None
+        self.notes: list[str] = []  # what the servo decided and the user should know
+        self.stop_reason = ""  # set when the run must end: by the servo itself, or request_stop
         self.mismatches = 0
         self.observers: list[Observer] = []  # called with a Snapshot after every frame
-        self.stop_reason: str | None = None  # set by request_stop; the robot stays stopped
+        self.requested_stop: str | None = None  # why the user stopped the run (request_stop)
+        self._noise: list[float] = []
+        self._measuring = noise_frames > 1
+        self._target_history: list[float] = []
+        self._remeasure_t: float | None = None
+        self._doubt = (0, "")  # consecutive re-measures that disagree, and how
+        self._prev: tuple[float, float, float] | None = None  # t_right, right u, skew-free d
+        self._latency_floor: float | None = None
+        self._last_capture: float | None = None
+
+    def _frame(self) -> StereoFrame:
+        frame = self.source.read()
+        if frame is None:
+            raise CameraError("the camera ended")
+        return frame
+
+    @staticmethod
+    def _exposed(frame: StereoFrame) -> StereoFrame:
+        """The pair with the right view brought to the left's exposure."""
+        return StereoFrame(frame.left, match_exposure(frame.left, frame.right), frame.t_left,
+                           frame.t_right)
+
+    # ------------------------------------------------------------------ reference phase
 
     def request_stop(self, reason: str) -> None:
         """Stop the robot at the next frame (any thread may call this); that step's phase is
-        "stopped", and the caller's loop ends there."""
-        self.stop_reason = reason
+        "stop", and the caller's loop ends there."""
+        self.requested_stop = self.stop_reason = reason
 
-    def _notify(self, frame, phase: str, reason: str, disp, y0: int, pair, row,
-                rtt_ms: float = math.nan) -> None:
+    def _notify(self, frame: StereoFrame, phase: str, reason: str, disp, y0: int,
+                pair: MarkerPair | None, row, rtt_ms: float = math.nan) -> None:
         if self.observers:
             snap = Snapshot(self.clock(), phase, reason, frame.left, disp, y0, self.target, pair,
                             row, link_stats(self.link, rtt_ms), self.geometry)
             for observer in self.observers:
                 observer(snap)
 
-    def _frame(self):
-        frame = self.source.read()
-        if frame is None:
-            raise CameraError("the camera ended")
-        return frame
-
     def reference(self) -> Target:
         disps = []
         for _ in range(self.reference_frames):
-            f = self._frame()
+            f = self._exposed(self._frame())
             disps.append(compute_disparity(f.left, f.right, self.params))
-            self.link.stop()  # keeps the link alive while the robot waits
             self._notify(f, "reference", "measuring the scene", disps[-1], 0, None, None)
+            self.link.stop()  # keeps the link alive while the robot waits
         h, w = disps[0].shape
-        self.target, _ = reference_target(disps, self.min_area or (w * h) // 100)
-        if self.tolerance_m is not None:
-            tol = self.tolerance_m * self.geometry.px_per_m(self.target.disparity)
-            self.control = dataclasses.replace(self.control, tolerance_px=tol)
-        self.controller = Controller(self.target.disparity, self.control)
+        self.min_area = self.min_area or (w * h) // 100
+        self.target, self.floor = reference_target(disps, self.min_area)
+        self._target_history = [self.target.disparity] * 2
+        self.controller = Controller(self.geometry.depth_m(self.target.disparity), self.control)
         return self.target
 
-    def _robot_disparity(self, frame, pair) -> float:
+    @property
+    def target_m(self) -> float:
+        assert self.controller is not None
+        return self.controller.target_m
+
+    # --------------------------------------------------------------------- perception
+
+    def _band_params(self, d: float) -> MatcherParams:
+        """The matcher's search range around the marker's disparity d (16 px wide)."""
+        return self.params.replace(min_disparity=max(0, int(d) - 8), num_disparities=16)
+
+    def _robot_disparity(self, frame: StereoFrame, pair: MarkerPair
+                         ) -> tuple[float, np.ndarray, tuple[int, int]]:
         """Block-matching disparity over the marker (a band of rows, or the whole map)."""
+        params = self._band_params(pair.disparity)
         if self.full_map:
-            self._map = (compute_disparity(frame.left, frame.right, self.params), 0)
-            return block_disparity(self._map[0], pair.left)
+            disp = compute_disparity(frame.left, frame.right, params)
+            return block_disparity(disp, pair.left), disp, (0, frame.left.shape[0])
+        # only the window the ring's matches need: its rows, its columns and, to their left,
+        # the search range in the right view
         r = pair.left.radius
-        pad = 2 * r + self.params.block_size
-        y0 = max(0, int(pair.left.v - pad))
-        y1 = min(frame.left.shape[0], int(pair.left.v + pad) + 1)
-        band = compute_disparity(frame.left[y0:y1], frame.right[y0:y1], self.params)
-        self._map = (band, y0)
-        shifted = type(pair.left)(pair.left.u, pair.left.v - y0, r)
-        return block_disparity(band, shifted)
+        pad = 1.6 * r + self.params.block_size
+        h, w = frame.left.shape[:2]
+        y0, y1 = max(0, int(pair.left.v - pad)), min(h, int(pair.left.v + pad) + 1)
+        reach = params.min_disparity + params.num_disparities
+        x0, x1 = max(0, int(pair.left.u - pad) - reach), min(w, int(pair.left.u + pad) + 1)
+        band = compute_disparity(frame.left[y0:y1, x0:x1], frame.right[y0:y1, x0:x1], params)
+        shifted = type(pair.left)(pair.left.u - x0, pair.left.v - y0, r, pair.left.aspect)
+        full = np.full((y1 - y0, w), np.nan, np.float32)
+        full[:, x0:x1] = band
+        return block_disparity(band, shifted), full, (y0, y1)
+
+    def _timing(self, frame: StereoFrame) -> str:
+        """Why the frame is unusable by its capture times ("stale", "skew"), or ""."""
+        now = self.clock()
+        latency = now - frame.t_left
+        if self._latency_floor is None or latency < self._latency_floor:
+            self._latency_floor = latency
+        gap = frame.t_left - self._last_capture if self._last_capture is not None else 0.0
+        self._last_capture = frame.t_left
+        if gap > self.stale_s or latency - self._latency_floor > self.stale_s:
+            return "stale"
+        if abs(frame.t_right - frame.t_left) > self.max_skew_s:
+            return "skew"
+        return ""
+
+    def _skew_corrected(self, frame: StereoFrame, pair: MarkerPair) -> float:
+        """The pair's disparity as if the right sensor had captured with the left: the right
+        centre moved back by its measured image speed times the skew."""
+        d = pair.disparity
+        skew = frame.t_right - frame.t_left
+        if self._prev is not None and skew and frame.t_right > self._prev[0]:
+            speed = (pair.right.u - self._prev[1]) / (frame.t_right - self._prev[0])
+            if frame.t_right - self._prev[0] < 3 * self.stale_s:
+                d += speed * skew
+        self._prev = (frame.t_right, pair.right.u, d)
+        return d
+
+    # ---------------------------------------------------------------------- the target
+
+    def _robot_region(self, pair: MarkerPair, shape: tuple[int, ...]) -> tuple[int, ...]:
+        """Image box (x0, y0, x1, y1) the robot may cover, from its marker."""
+        ppm = pair.disparity / self.geometry.baseline_m
+        h, w = shape[:2]
+        u, v, r = pair.left.u, pair.left.v, pair.left.radius
+        half = self.robot_half_width_m * ppm
+        return (max(0, int(u - half)), max(0, int(v - 2 * r)), min(w, int(u + half) + 1),
+                min(h, int(v + self.robot_below_marker_m * ppm) + 1))
+
+    def _remeasure(self, frame: StereoFrame, pair: MarkerPair | None) -> None:
+        """Measure the nearest object again, the robot's region left out; follow it."""
+        assert self.target is not None and self.controller is not None
+        disp = compute_disparity(frame.left, frame.right, self.params)
+        if pair is not None:
+            x0, y0, x1, y1 = self._robot_region(pair, disp.shape)
+            disp[y0:y1, x0:x1] = np.nan
+        disp = without_floor(disp, self.floor)
+        old = self.target
+        bx, by, bw, bh = old.bbox
+        there = disp[by:by + bh, bx:bx + bw]
+        there = there[np.isfinite(there)]
+        if there.size < self.min_area // 4:
+            return  # the robot hides the object: nothing to learn
+        try:
+            found: Target | None = nearest_object(disp, self.min_area)
+        except HostError:
+            found = None
+        overlap = found is not None and min(bx + bw, found.bbox[0] + found.bbox[2]) - max(
+            bx, found.bbox[0]) > 0.3 * min(bw, found.bbox[2])
+        if found is not None and overlap:
+            self._doubt = (0, "")
+            self._target_history.append(found.disparity)
+            median = float(np.median(self._target_history[-3:]))
+            self.target = Target(median, found.area, found.bbox, found.spread)
+        else:
+            still = float(np.median(there)) > old.disparity - max(1.0, 0.1 * old.disparity)
+            kind = "appeared" if still else "vanished"
+            n = self._doubt[0] + 1 if self._doubt[1] == kind else 1
+            self._doubt = (n, kind)
+            if n < 2:
+                return
+            if kind == "vanished":
+                self.stop_reason = "target vanished"
+                return
+            assert found is not None
+            self.notes.append(f"a nearer object appeared at {found.disparity:.2f} px: "
+                              f"retargeting")
+            self.target = found
+            self._target_history = [found.disparity] * 2
+        self.controller.target_m = self.geometry.depth_m(self.target.disparity)
+
+    # ---------------------------------------------------------------------- noise phase
+
+    def _noise_phase(self, disparity: float) -> bool:
+        """Collect the standing robot's disparities; at the end widen a tolerance below the
+        depth noise at the target. True while the phase goes on."""
+        self._noise.append(disparity)
+        if len(self._noise) < self.noise_frames:
+            return True
+        assert self.controller is not None
+        cfg = self.controller.cfg
+        sd = float(np.std(self._noise, ddof=1))
+        z = self.controller.target_m
+        sigma_z = z * z * sd / (self.geometry.focal_px * self.geometry.baseline_m)
+        # the controller decides on a line fitted through fit_frames: its end point has about
+        # 2 / sqrt(n) of one frame's noise; the band must hold two of those
+        floor = 2 * 2 * sigma_z / math.sqrt(cfg.fit_frames)
+        if cfg.tolerance_m < floor:
+            self.notes.append(f"tolerance {cfg.tolerance_m * 100:.1f} cm is below the depth "
+                              f"noise at the target ({sigma_z * 100:.2f} cm a frame at "
+                              f"{z:.2f} m): widened to {floor * 100:.1f} cm")
+            self.controller.cfg = cfg.__class__(**{**cfg.__dict__, "tolerance_m": floor})
+        return False
+
+    @property
+    def tolerance_m(self) -> float:
+        assert self.controller is not None
+        return self.controller.cfg.tolerance_m
+
+    # ----------------------------------------------------------------------------- step
 
     def step(self, truth_depth_m: float = math.nan) -> LogRow:
         """One frame of the robot phase: perceive, decide, command, log."""
         assert self.controller is not None and self.target is not None
-        stop_reason = self.stop_reason  # read once: a STOP pressed meanwhile acts next frame
-        last = self.rows[-1].t if self.rows else None
+        last = self.rows[-1] if self.rows else None
         frame = self._frame()
         t_wall = time.perf_counter()
-        now = self.clock()
+        frame = self._exposed(frame)
+        invalid = self._timing(frame)
         pair = find_marker(frame.left, frame.right, self.marker, self.marker_radius_m,
                            self.geometry.baseline_m, self.last_pair)
-        self._map = (None, 0)
         robot = block = math.nan
         lateral = None
+        disp, rows = None, (0, 0)
         if pair is not None:
-            block = self._robot_disparity(frame, pair)
+            block, disp, rows = self._robot_disparity(frame, pair)
             if math.isfinite(block) and abs(block - pair.disparity) > self.max_mismatch_px:
                 self.mismatches += 1  # two blobs that are not the marker's two views
                 pair = None
             else:
                 self.last_pair = pair
-                robot = pair.disparity
+                robot = self._skew_corrected(frame, pair)
                 lateral = self.geometry.baseline_m * (pair.left.u - self.geometry.cx) / robot
-        stale = last is not None and now - last > self.stale_s
-        obs = Observation(now, None if (pair is None or stale) else robot, lateral)
-        cmd = self.controller.update(obs)
-        if stale:
-            cmd = Command(0, 0, "stale", cmd.error)
-        if stop_reason is not None:
-            cmd = Command(0, 0, "stopped", cmd.error)
+        if self._remeasure_t is None or frame.t_left - self._remeasure_t >= self.remeasure_s:
+            self._remeasure_t = frame.t_left
+            if self.controller.phase != "turn":
+                self._remeasure(frame, pair)
+        seen = pair is not None and not invalid
+        stop_reason = self.stop_reason  # read once: a STOP requested meanwhile acts next frame
+        if stop_reason:
+            cmd = Command(0, 0, "stop", None)
+        elif seen and self._measuring:
+            self._measuring = self._noise_phase(robot)
+            cmd = Command(0, 0, "measure", None)
+        else:
+            depth = self.geometry.depth_m(robot) if seen else None
+            aspect = pair.left.aspect if pair is not None else 1.0
+            cmd = self.controller.update(Observation(frame.t_left, depth, lateral, aspect,
+                                                     invalid))
         t_send = time.perf_counter()
         self._send(cmd)
         rtt_ms = (time.perf_counter() - t_send) * 1000
-        hz = 1.0 / (now - last) if last is not None and now > last else math.nan
-        row = LogRow(now, cmd.phase, self.target.disparity, robot, block,
-                     math.nan if cmd.error is None else cmd.error, cmd.left, cmd.right, hz,
-                     (time.perf_counter() - t_wall) * 1000, truth_depth_m)
+        hz = (1.0 / (frame.t_left - last.t) if last is not None and frame.t_left > last.t
+              else math.nan)
+        reason = stop_reason or (invalid if invalid else
+                                      "marker not seen" if cmd.is_stop and pair is None else "")
+        depth_m = self.geometry.depth_m(robot) if math.isfinite(robot) else math.nan
+        row = LogRow(frame.t_left, cmd.phase, reason, self.target_m, depth_m,
+                     math.nan if cmd.error_m is None else cmd.error_m, self.target.disparity,
+                     robot, block, cmd.left, cmd.right, hz,
+                     (time.perf_counter() - t_wall) * 1000,
+                     (frame.t_right - frame.t_left) * 1000, truth_depth_m)
         self.rows.append(row)
-        self._notify(frame, cmd.phase, stop_reason or _why_stopped(cmd), *self._map, pair, row,
-                     rtt_ms)
+        self.last = Step(frame, disp, rows, self.target, pair, row)
+        self._notify(frame, cmd.phase, reason, disp, rows[0], pair, row, rtt_ms)
         return row
 
     def _send(self, cmd: Command) -> None:
@@ -173,13 +372,14 @@ class Servo:
                 return True
         return False
 
-
-def _why_stopped(cmd: Command) -> str:
-    """Why a command holds the robot still, in a few words ("" when it may move)."""
-    if cmd.phase == "stale":
-        return "no frame for too long"
-    if cmd.phase == "lost":
-        return "marker lost"
-    if cmd.phase == "hold":
-        return "marker not seen" if cmd.error is None else "at the target"
-    return ""
+    def outcome(self) -> tuple[str, str]:
+        """("held", "") when the last step held at the target with the marker in view, else
+        ("stopped", the reason)."""
+        if not self.rows:
+            return "stopped", "no frame"
+        last = self.rows[-1]
+        if last.phase == "hold" and math.isfinite(last.depth_m):
+            return "held", ""
+        if not any(math.isfinite(r.robot_px) for r in self.rows):
+            return "stopped", "the marker was never seen"
+        return "stopped", last.reason or f"ended in phase {last.phase}"

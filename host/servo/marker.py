@@ -22,6 +22,7 @@ class Blob:
     u: float  # column, px
     v: float  # row, px
     radius: float  # px (vertical semi-axis of the disc)
+    aspect: float = 1.0  # width / height of the disc: |cos| of the card's angle to the camera
 
 
 @dataclass(frozen=True)
@@ -51,12 +52,13 @@ def _centroid(grey: np.ndarray, cx: float, cy: float, r: float) -> tuple[float, 
     return float((weight * xs).sum() / total), float((weight * ys).sum() / total)
 
 
-def find_discs(image: np.ndarray, min_radius: float = 2.5, max_radius: float = 80.0
-               ) -> list[Blob]:
-    """Dark, round blobs inside a lighter ring."""
+def find_discs(image: np.ndarray, min_radius: float = 2.5, max_radius: float = 80.0,
+               window: int = 31) -> list[Blob]:
+    """Dark, round blobs inside a lighter ring; window (px, odd) is the neighbourhood the disc
+    is darker than, and must be wider than the disc (find_marker sizes it)."""
     grey = to_grey(image)
     # dark relative to the neighbourhood: the ring makes the disc stand out locally
-    local = cv2.blur(grey, (31, 31))
+    local = cv2.blur(grey, (window, window))
     mask = (grey.astype(np.int16) < local.astype(np.int16) - 40).astype(np.uint8)
     mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, np.ones((2, 2), np.uint8))
     contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
@@ -78,7 +80,9 @@ def find_discs(image: np.ndarray, min_radius: float = 2.5, max_radius: float = 8
         # printed: a uniform light ring round a uniform dark disc (texture is neither)
         if ring - disc < 80 or max(ring_sd, disc_sd) > 0.2 * (ring - disc):
             continue
-        blobs.append(Blob(u, v, r))
+        m = cv2.moments(c)
+        aspect = math.sqrt(m["mu20"] / m["mu02"]) if m["mu02"] > 0 else 1.0
+        blobs.append(Blob(u, v, r, aspect))
     return blobs
 
 
@@ -109,19 +113,22 @@ def find_aruco(image: np.ndarray) -> list[Blob]:
 
 
 def find_markers(left: np.ndarray, right: np.ndarray, kind: str = "disc",
-                 max_row_error: float = 2.0, windows: tuple | None = None
+                 max_row_error: float = 2.0, windows: tuple | None = None, window: int = 31
                  ) -> list[MarkerPair]:
     """Candidate marker pairs in a rectified pair: a left blob and a right blob on the same row
     to its left (positive disparity) with a similar size. windows: ((x0, y0, x1, y1) left,
     (x0, y0, x1, y1) right) to search in, else the whole images."""
-    find = find_aruco if kind == "aruco" else find_discs
+    def find(img: np.ndarray) -> list[Blob]:
+        return find_aruco(img) if kind == "aruco" else find_discs(img, window=window)
+
     found = []
     for img, win in zip((left, right), windows or (None, None)):
         if win is None:
             found.append(find(img))
             continue
         x0, y0, x1, y1 = win
-        found.append([Blob(b.u + x0, b.v + y0, b.radius) for b in find(img[y0:y1, x0:x1])])
+        found.append([Blob(b.u + x0, b.v + y0, b.radius, b.aspect)
+                      for b in find(img[y0:y1, x0:x1])])
     pairs = []
     for a in found[0]:
         for b in found[1]:
@@ -143,7 +150,9 @@ def find_marker(left: np.ndarray, right: np.ndarray, kind: str = "disc",
                 near: MarkerPair | None = None) -> MarkerPair | None:
     """The marker: among the candidates whose size fits their distance (a disc of radius_m at
     disparity d spans radius_m * d / baseline_m px; within 35%), the one nearest to the last
-    sighting `near` (searched for around it first), else the largest."""
+    sighting `near` (searched for around it first), else the largest. The neighbourhood the
+    disc must be darker than grows with the disc: from the last sighting, or at 31 px and then,
+    if nothing is found, 121 px (a marker near the camera)."""
     def fits(p: MarkerPair) -> bool:
         if radius_m is None or baseline_m is None:
             return True
@@ -153,9 +162,13 @@ def find_marker(left: np.ndarray, right: np.ndarray, kind: str = "disc",
     pairs = []
     if near is not None:
         windows = (_window(near.left, left.shape), _window(near.right, right.shape))
-        pairs = [p for p in find_markers(left, right, kind, windows=windows) if fits(p)]
-    if not pairs:
-        pairs = [p for p in find_markers(left, right, kind) if fits(p)]
+        size = max(31, 2 * int(3 * near.left.radius) + 1)
+        pairs = [p for p in find_markers(left, right, kind, windows=windows, window=size)
+                 if fits(p)]
+    for size in (31, 121):
+        if pairs:
+            break
+        pairs = [p for p in find_markers(left, right, kind, window=size) if fits(p)]
     if not pairs:
         return None
     if near is not None:

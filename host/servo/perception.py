@@ -111,3 +111,15 @@ def reference_target(disps: list[np.ndarray], min_area: int) -> tuple[Target, Fl
         median = np.nanmedian(stack, axis=0) if len(disps) > 1 else stack[0]
     floor = fit_floor(median)
     return nearest_object(without_floor(median, floor), min_area), floor
+
+
+def match_exposure(left: np.ndarray, right: np.ndarray) -> np.ndarray:
+    """The right view with the left's exposure: each channel scaled and shifted so its mean and
+    spread equal the left's (the Minoru's two sensors expose and balance separately, and a
+    sum of absolute differences reads every grey level of difference as mismatch)."""
+    lf, rf = left.reshape(-1, *left.shape[2:]), right.reshape(-1, *right.shape[2:])
+    lm, ls = lf.mean(axis=0), lf.std(axis=0)
+    rm, rs = rf.mean(axis=0), rf.std(axis=0)
+    scale = ls / np.maximum(rs, 1e-6)
+    out = (right.astype(np.float32) - rm) * scale + lm
+    return np.clip(np.rint(out), 0, 255).astype(np.uint8)

@@ -33,20 +33,21 @@ def plot_run(path: str | os.PathLike[str], rows: list[LogRow], geometry: Geometr
     t = [r.t - rows[0].t for r in rows]
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(10, 7), sharex=True,
                                    gridspec_kw={"height_ratios": [1.4, 1]})
-    depth = [geometry.depth_m(r.robot_px) if r.robot_px > 0 else math.nan for r in rows]
-    target = geometry.depth_m(rows[0].target_px)
+    depth = [r.depth_m for r in rows]
     ax1.plot(t, depth, ".", ms=3, label="robot depth from the marker's disparity")
     if any(math.isfinite(r.truth_depth_m) for r in rows):
         ax1.plot(t, [r.truth_depth_m for r in rows], "-", lw=1, label="robot depth (truth)")
-    ax1.axhline(target, color="k", ls="--", lw=1, label=f"target (nearest object) "
-                                                        f"{target:.3f} m")
+    ax1.plot(t, [r.target_m for r in rows], "k--", lw=1,
+             label=f"target (nearest object), last {rows[-1].target_m:.3f} m")
     ax1.set_ylabel("depth (m)")
     ax1.legend(loc="best", fontsize=8)
     ax1.grid(alpha=0.3)
-    ax1.set_title(f"servo run: target disparity {rows[0].target_px:.2f} px")
+    ax1.set_title(f"servo run at {geometry.focal_px:.0f} px focal length: target "
+                  f"{rows[-1].target_m:.3f} m")
     ax2.plot(t, [r.left for r in rows], label="left duty")
     ax2.plot(t, [r.right for r in rows], label="right duty")
-    for phase, colour in (("turn", "tab:orange"), ("hold", "tab:green"), ("lost", "tab:red")):
+    for phase, colour in (("turn", "tab:orange"), ("hold", "tab:green"), ("lost", "tab:red"),
+                          ("stale", "tab:purple")):
         on = [r.phase == phase for r in rows]
         ax2.fill_between(t, -1000, 1000, where=on, color=colour, alpha=0.12, step="mid",
                          label=phase)

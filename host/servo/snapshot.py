@@ -36,7 +36,7 @@ class Snapshot:
     """One step: the rectified left image, the disparity the step computed, what was found."""
 
     t: float  # s, the loop's clock
-    phase: str  # reference, drive, turn, hold, lost, stale, stopped
+    phase: str  # reference, then the LogRow phases (measure, drive, creep, hold, turn, stop ...)
     reason: str  # why the robot is stopped ("" while it may move)
     left: np.ndarray  # rectified left image, uint8 BGR or grey
     disparity: np.ndarray | None  # px, NaN = invalid; rows disparity_y0.. of the image

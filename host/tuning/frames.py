@@ -37,12 +37,14 @@ def sim_pairs(width: int, height: int, count: int
               ) -> tuple[list[tuple[np.ndarray, np.ndarray]], float]:
     """Frames of the simulated world with the robot at several depths, and its focal_px *
     baseline_m (for a depth range)."""
-    from host.servo.world import World
+    from host.sim.renderer import Renderer
+    from host.sim.world import World
 
     world = World.for_size(width, height)
+    renderer = Renderer(world)
     pairs = []
     for i in range(count):
         world.robot.z_m = SIM_DEPTHS_M[i % len(SIM_DEPTHS_M)]
-        frame, _ = world.render(i / 30.0)
+        frame = renderer.frame()
         pairs.append((frame.left, frame.right))
     return pairs, world.geometry.focal_px * world.geometry.baseline_m

@@ -1,51 +1,24 @@
-"""A closed-loop run of the servo in the simulated world, with the emulator on a pty."""
+"""A closed-loop run of the servo in the simulated world (host.sim.run), for the tests."""
 
 from __future__ import annotations
 
 import contextlib
-from dataclasses import dataclass
+import dataclasses
 
-from host.emulator.emulator import Emulator, Faults, PtyService
-from host.link.client import RobotLink
+from host.emulator.emulator import Faults
 from host.servo.controller import ControlConfig
-from host.servo.loop import Servo
-from host.servo.sim_source import SimSource
-from host.servo.world import World
-from host.stereo import MatcherParams
-
-PARAMS = MatcherParams(block_size=9, num_disparities=48, border="clip")
-
-
-@dataclass
-class Sim:
-    world: World
-    emulator: Emulator
-    source: SimSource
-    servo: Servo
-    depths: list[float]
-
-    def run(self, seconds: float, settle: float | None = 1.0) -> None:
-        while self.source.t < seconds:
-            self.servo.step(self.world.robot.z_m)
-            self.depths.append(self.world.robot.z_m)
-            if settle and self.servo.held_for(settle):
-                return
+from host.sim.faults import WorldFaults
+from host.sim.run import Setup
+from host.sim.run import simulation as sim_run
 
 
 @contextlib.contextmanager
 def simulation(start_depth: float, seed: int = 0, faults: Faults = Faults(),
-               mode: str = "turn", retries: int = 8):
-    world = World(seed=seed)
-    world.robot.z_m = start_depth
-    emulator = Emulator(faults, line_rate=False)
-    with PtyService(emulator, realtime=False) as service, \
-            RobotLink(service.path, retries=retries, reply_timeout_s=0.05) as link:
-        source = SimSource(world, emulator)
-        control = ControlConfig(turn_s=world.motors.turn_seconds(ControlConfig.turn_duty),
-                                mode=mode)
-        servo = Servo(source, link, PARAMS, world.geometry, control, clock=source.clock,
-                      tolerance_m=0.01)
-        servo.reference()
-        z = world.geometry.depth_m(servo.target.disparity)
-        assert abs(z - world.nearest_box().z_m) < 0.02
-        yield Sim(world, emulator, source, servo, [])
+               mode: str = "turn", retries: int = 8, world: WorldFaults = WorldFaults(),
+               size: tuple[int, int] = (320, 240), **setup):
+    world_faults = dataclasses.replace(world, link=faults)
+    with sim_run(Setup(size, start_depth, faults=world_faults, seed=seed,
+                       control=ControlConfig(mode=mode), retries=retries, **setup)) as sim:
+        z = sim.servo.target_m
+        assert abs(z - sim.world.nearest_box().z_m) < 0.02
+        yield sim

@@ -10,7 +10,9 @@ import pytest
 
 from host.servo.marker import find_marker
 from host.servo.perception import reference_target
-from host.servo.world import Box, World
+from host.sim.faults import CameraFaults
+from host.sim.renderer import Renderer
+from host.sim.world import Box, World
 from host.stereo import MatcherParams, compute_disparity
 
 PARAMS = MatcherParams(block_size=9, num_disparities=48, border="clip")
@@ -25,10 +27,11 @@ LAYOUTS = [
 @pytest.mark.parametrize("speckle", [0.0, 0.02])
 def test_nearest_object_is_the_nearest_box(boxes, speckle: float) -> None:
     world = World(boxes=boxes, seed=7)
+    renderer = Renderer(world, seed=7)
     rng = np.random.default_rng(1)
     disps = []
     for _ in range(3):
-        frame, _ = world.render(with_robot=False)
+        frame = renderer.frame(with_robot=False)
         d = compute_disparity(frame.left, frame.right, PARAMS)
         spots = rng.random(d.shape) < speckle  # speckle: single pixels with wild disparities
         d[spots] = rng.uniform(30, 47, spots.sum())
@@ -47,10 +50,11 @@ def test_nearest_object_is_the_nearest_box(boxes, speckle: float) -> None:
 @pytest.mark.parametrize("z", [0.7, 1.1, 1.6, 2.2, 2.8])
 @pytest.mark.parametrize("side", [-0.2, 0.0, 0.2])
 def test_marker_centres_within_half_a_pixel_on_noisy_renders(z: float, side: float) -> None:
-    world = World(seed=3, noise=5.0)
+    world = World(seed=3)
+    renderer = Renderer(world, CameraFaults(noise=5.0), seed=3)
     world.robot.z_m, world.robot.x_m = z, side * z  # from the left edge to the right one
     world.robot.theta = math.radians(12)
-    frame, _ = world.render()
+    frame = renderer.frame()
     pair = find_marker(frame.left, frame.right, radius_m=0.03, baseline_m=0.06)
     u, v, d = world.marker_truth()
     assert pair is not None

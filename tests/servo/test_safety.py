@@ -15,7 +15,7 @@ def test_hidden_marker_stops_the_robot_within_one_frame() -> None:
     with simulation(0.75) as sim:
         for _ in range(15):
             sim.servo.step(sim.world.robot.z_m)
-        assert sim.servo.rows[-1].phase == "drive" and sim.emulator.motors() != (0, 0)
+        assert sim.servo.rows[-1].phase in ("drive", "creep") and sim.emulator.motors() != (0, 0)
         sim.world.robot.marker_hidden = True
         row = sim.servo.step(sim.world.robot.z_m)  # the first frame without the marker
         assert (row.left, row.right) == (0, 0)
@@ -26,7 +26,7 @@ def test_hidden_marker_stops_the_robot_within_one_frame() -> None:
         sim.world.robot.marker_hidden = False
         for _ in range(3):
             row = sim.servo.step(sim.world.robot.z_m)
-        assert row.phase == "drive"  # it goes on once the marker is back
+        assert row.phase in ("drive", "creep")  # it goes on once the marker is back
 
 
 def test_a_silent_robot_is_reported_and_its_link_loss_stop_holds() -> None:
@@ -35,14 +35,11 @@ def test_a_silent_robot_is_reported_and_its_link_loss_stop_holds() -> None:
             sim.run(10.0, settle=None)
         assert sim.emulator.motors() != (0, 0)  # it was driving when the line went dead
         for _ in range(300):  # the world and the robot's firmware run on, no frame arrives
-            sim.world.step(0.001, *sim.emulator.motors())
-            sim.emulator.advance(1)
+            sim.source.run_ms(1)
         assert sim.emulator.motors() == (0, 0)  # the firmware's link-loss stop
         for _ in range(500):  # the wheels run down (motor lag)
-            sim.world.step(0.001, *sim.emulator.motors())
-            sim.emulator.advance(1)
+            sim.source.run_ms(1)
         z = sim.world.robot.z_m
         for _ in range(1000):
-            sim.world.step(0.001, *sim.emulator.motors())
-            sim.emulator.advance(1)
+            sim.source.run_ms(1)
         assert abs(sim.world.robot.z_m - z) < 0.001  # and the robot stays where it stopped

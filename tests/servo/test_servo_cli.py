@@ -21,9 +21,10 @@ def test_sim_run_writes_log_and_plot(tmp_path: Path) -> None:
     r = run("--sim", "--start-depth", "0.9", "--border", "clip", "--num-disp", "48",
             "--log", str(log), "--plot", str(fig))
     assert r.returncode == 0, r.stderr
-    assert "target: nearest object at disparity" in r.stderr and "held at disparity" in r.stderr
+    assert "target: nearest object at disparity" in r.stderr and "held at " in r.stderr
     rows = list(csv.DictReader(log.open()))
-    assert {"t", "phase", "target_px", "robot_px", "error_px", "left", "right"} <= set(rows[0])
+    assert {"t", "phase", "reason", "target_m", "depth_m", "error_m", "robot_px", "left",
+            "right"} <= set(rows[0])
     assert rows[-1]["phase"] == "hold" and (rows[-1]["left"], rows[-1]["right"]) == ("0", "0")
     assert abs(float(rows[-1]["truth_depth_m"]) - 1.2) < 0.03
     assert cv2.imread(str(fig)) is not None
@@ -36,3 +37,13 @@ def test_missing_port_and_bad_camera_are_one_line_errors(tmp_path: Path) -> None
     assert r.returncode == 2 and "no such folder" in r.stderr and r.stderr.count("\n") == 1
     r = run("--camera", "sim", "--port", "/dev/ttyNOPE0")
     assert r.returncode == 2 and "needs --port emulator" in r.stderr
+    r = run("--sim", "--drop", "1.5")
+    assert r.returncode == 2 and "--drop must be a probability" in r.stderr
+
+
+def test_link_fault_options_reach_the_simulated_robot() -> None:
+    """host servo --sim takes the emulator's link faults: a robot that goes silent ends the run
+    with the link's error, not a hold."""
+    r = run("--sim", "--start-depth", "0.9", "--border", "clip", "--num-disp", "48",
+            "--drop", "0.001", "--corrupt", "0.001", "--delay-ms", "5", "--silent-after", "1500")
+    assert r.returncode != 0 and "did not answer" in r.stderr and "held at" not in r.stderr

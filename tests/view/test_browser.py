@@ -78,8 +78,8 @@ def test_stop_stops_the_robot_and_ends_the_run(run):
     assert "stopped (STOP pressed in the view)" in result["stderr"]
     assert "the robot reports duty 0 0 after STOP" in result["stderr"]  # STATUS from the emulator
     rows = list(csv.DictReader((out / "run.csv").open()))
-    assert rows[-1]["phase"] == "stopped" and (rows[-1]["left"], rows[-1]["right"]) == ("0", "0")
+    assert rows[-1]["phase"] == "stop" and (rows[-1]["left"], rows[-1]["right"]) == ("0", "0")
     assert any(r["phase"] == "drive" for r in rows)
     after = result["after_stop"]
-    assert after["phase"] == "stopped" and after["reason"].startswith("STOP pressed in the view")
+    assert after["phase"] == "stop" and after["reason"].startswith("STOP pressed in the view")
     assert not after["stop_enabled"]

@@ -1,6 +1,6 @@
 """The servo's read-only interface to the view: every step reaches the observers as a Snapshot
 (image, disparity, target, marker, row, link stats), and request_stop makes the next step send
-STOP with phase "stopped"."""
+STOP with phase "stop"."""
 
 from __future__ import annotations
 
@@ -8,23 +8,14 @@ import numpy as np
 
 from host.emulator.emulator import Emulator, PtyService
 from host.link.client import RobotLink
-from host.servo.controller import ControlConfig
-from host.servo.loop import Servo
-from host.servo.sim_source import SimSource
 from host.servo.snapshot import Snapshot
-from host.servo.world import World
-from host.stereo import MatcherParams
+from host.sim.run import Setup, simulation
 
 
 def test_observers_see_every_step_and_stop_is_sent():
-    world = World()
-    world.robot.z_m = 1.9
-    emulator = Emulator(line_rate=False)
-    params = MatcherParams(border="clip", num_disparities=48)
     seen: list[Snapshot] = []
-    with PtyService(emulator, realtime=False) as service, RobotLink(service.path) as link:
-        servo = Servo(SimSource(world, emulator), link, params, world.geometry,
-                      ControlConfig(turn_s=world.motors.turn_seconds(ControlConfig.turn_duty)))
+    with simulation(Setup(), reference=False) as sim:
+        servo, link, emulator = sim.servo, sim.link, sim.emulator
         servo.observers.append(seen.append)
         servo.reference()
         assert [s.phase for s in seen] == ["reference"] * 5
@@ -43,8 +34,8 @@ def test_observers_see_every_step_and_stop_is_sent():
         assert band.link.reset_cause == "power on"
         servo.request_stop("pressed")
         row = servo.step()
-        assert row.phase == "stopped" and (row.left, row.right) == (0, 0)
-        assert seen[-1].phase == "stopped" and seen[-1].reason == "pressed"
+        assert row.phase == "stop" and (row.left, row.right) == (0, 0)
+        assert seen[-1].phase == "stop" and seen[-1].reason == "pressed"
         assert link.status().left == 0 and emulator.motors() == (0, 0)
     assert not any(np.shares_memory(s.left, t.left) for s, t in zip(seen, seen[1:]))
 

@@ -16,13 +16,14 @@ import aiohttp
 import cv2
 import numpy as np
 
-from host.servo.world import World
+from host.sim.renderer import Renderer
+from host.sim.world import World
 
 
 def _recording(folder: Path, frames: int = 3) -> None:
-    world = World()
+    renderer = Renderer(World())
     for i in range(frames):
-        pair, _ = world.render(i / 30, with_robot=True)
+        pair = renderer.frame(with_robot=True)
         cv2.imwrite(str(folder / f"left_{i:03d}.png"), pair.left)
         cv2.imwrite(str(folder / f"right_{i:03d}.png"), pair.right)
 

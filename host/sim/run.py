@@ -1,0 +1,104 @@
+"""One simulated servo run: the world with its faults, the renderer, the firmware's core on a pty
+as the robot (or a board running the real AVR binary), the link and the servo, in lockstep
+simulated time."""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from typing import Any
+
+from host.camera.calibration import Rectifier
+from host.emulator.emulator import Emulator, PtyService
+from host.link.client import RobotLink
+from host.servo.controller import ControlConfig
+from host.servo.loop import Servo
+from host.sim.chessboard import calibrate_camera
+from host.sim.faults import WorldFaults
+from host.sim.renderer import Renderer
+from host.sim.source import SimSource
+from host.sim.world import Box, World
+from host.stereo.params import MatcherParams
+
+
+@dataclass(frozen=True)
+class Setup:
+    size: tuple[int, int] = (320, 240)
+    start_z_m: float = 1.9
+    start_x_m: float = 0.0
+    start_theta: float = 0.0
+    boxes: tuple[Box, ...] | None = None  # None: the default scene
+    faults: WorldFaults = field(default_factory=WorldFaults)
+    seed: int = 0
+    fps: float = 30.0
+    params: MatcherParams = MatcherParams(block_size=9, num_disparities=48, border="clip")
+    control: ControlConfig = ControlConfig()
+    retries: int = 8
+    board: Any = None  # a running Board (simavr ELF, simulated Uno) instead of the native core
+
+
+@dataclass
+class SimRun:
+    world: World
+    emulator: Any  # the board: the native Emulator, or one running the AVR binary
+    source: SimSource
+    servo: Servo
+    link: RobotLink
+    depths: list[float] = field(default_factory=list)
+
+    def step(self) -> None:
+        self.servo.step(self.world.robot.z_m)
+        self.depths.append(self.world.robot.z_m)
+
+    def run(self, seconds: float, settle: float | None = 1.0) -> None:
+        """Steps until `seconds` of simulated time, the servo stops itself, or it has held
+        for `settle` seconds."""
+        while self.source.t < seconds and not self.servo.stop_reason:
+            self.step()
+            if settle and self.servo.held_for(settle):
+                return
+
+    def depth_error_m(self) -> float:
+        """The robot's true depth minus its target object's true depth (m)."""
+        return self.world.robot.z_m - self.world.nearest_box().z_m
+
+
+@contextlib.contextmanager
+def simulation(setup: Setup = Setup(), reference: bool = True) -> Iterator[SimRun]:
+    kw = {} if setup.boxes is None else {"boxes": setup.boxes}
+    faults = setup.faults
+    world = World.for_size(*setup.size, seed=setup.seed, motor_faults=faults.motor, **kw)
+    r = world.robot
+    r.z_m, r.x_m, r.theta = setup.start_z_m, setup.start_x_m, setup.start_theta
+    # lockstep time moves only between frames, so a line delay is felt as a later command
+    link_faults = dataclasses.replace(faults.link, delay_ms=0.0)
+    renderer = Renderer(world, faults.camera, seed=setup.seed)
+    if setup.board is None:
+        emulator = Emulator(link_faults, line_rate=False)
+        board_cm: Any = PtyService(emulator, realtime=False)
+    else:  # a real-time board: advance() waits on the wall clock
+        emulator = setup.board
+        board_cm = contextlib.nullcontext(setup.board)
+    with board_cm as service, \
+            RobotLink(service.path, retries=setup.retries, reply_timeout_s=0.2) as link:
+        source = SimSource(world, emulator, setup.fps, renderer=renderer, events=faults.events,
+                           latency_ms=faults.motor.latency_ms + faults.link.delay_ms,
+                           seed=setup.seed)
+        geometry = world.geometry
+        if any(faults.camera.distortion):  # rectify as a user would: with a calibration
+            calib = calibrate_camera(world, faults.camera, setup.seed)
+            source.rectify = Rectifier(calib)
+            geometry = calib.geometry
+        servo = Servo(source, link, setup.params, geometry, setup.control, clock=source.clock)
+        run = SimRun(world, emulator, source, servo, link)
+        if reference:
+            servo.reference()
+        yield run
+
+
+def truth_target_error_m(run: SimRun) -> float:
+    """How far the servo's target is from the nearest box's true depth (m)."""
+    return run.servo.target_m - run.world.nearest_box().z_m if run.servo.target else math.nan

@@ -1,0 +1,125 @@
+"""The simulated world's state and physics: the Minoru's geometry, boxes at known depths, and
+the robot, a differential drive with a two-sided marker card (rendering is host.sim.renderer).
+
+World frame: the camera at the origin looking along +z (depth), x to the right, y up, its
+optical centre height_m above the floor. Heading theta of the robot: 0 = facing away from the
+camera (+z), positive turns to its right (+x).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from host.camera.calibration import Geometry
+from host.sim.faults import MotorFaults
+
+
+@dataclass(frozen=True)
+class Box:
+    """A box whose front face is at depth z_m, spanning x0..x1 and up to height_m."""
+
+    z_m: float
+    x0_m: float
+    x1_m: float
+    height_m: float
+
+
+@dataclass(frozen=True)
+class Motors:
+    """Motor model: no motion below the dead zone, then linear to v_max, first-order lag."""
+
+    v_max_mps: float = 0.35
+    dead_zone: int = 120  # permille
+    tau_s: float = 0.08
+    wheelbase_m: float = 0.14
+
+    def turn_seconds(self, duty: int) -> float:
+        """How long spinning in place at +duty/-duty takes to turn round (pi): the lag lost
+        at the start comes back as the wheels run down after the stop."""
+        return math.pi * self.wheelbase_m / (2 * self.speed(duty))
+
+    def speed(self, duty: float) -> float:
+        if abs(duty) <= self.dead_zone:
+            return 0.0
+        return math.copysign(self.v_max_mps * (abs(duty) - self.dead_zone)
+                             / (1000 - self.dead_zone), duty)
+
+
+@dataclass
+class Robot:
+    x_m: float = 0.0
+    z_m: float = 1.5
+    theta: float = 0.0
+    v_left: float = 0.0  # wheel speeds, m/s
+    v_right: float = 0.0
+    marker_height_m: float = 0.20
+    marker_radius_m: float = 0.03  # the dark disc; the light ring reaches ring_ratio times it
+    ring_ratio: float = 1.7
+    body_width_m: float = 0.16
+    body_height_m: float = 0.12
+    marker_hidden: bool = False  # something between the camera and the card (tests)
+    occlusion: float = 0.0  # fraction of the card's width hidden from its left edge
+
+
+@dataclass
+class World:
+    geometry: Geometry = field(default_factory=lambda: Geometry(426.0, 0.060, 160.0, 120.0))
+    size: tuple[int, int] = (320, 240)
+    height_m: float = 0.25  # camera above the floor
+    wall_z_m: float = 3.2
+    boxes: tuple[Box, ...] = (Box(1.2, -0.50, -0.18, 0.38), Box(1.8, 0.22, 0.55, 0.30),
+                              Box(2.4, 0.60, 0.95, 0.55))
+    robot: Robot = field(default_factory=Robot)
+    motors: Motors = field(default_factory=Motors)
+    motor_faults: MotorFaults = field(default_factory=MotorFaults)
+    seed: int = 0
+    target_index: int | None = None  # the box the servo should end at (None: the nearest)
+
+    def __post_init__(self) -> None:
+        self.rng = np.random.default_rng(self.seed + 7919)
+        self.t = 0.0
+        self.travelled_m = 0.0
+
+    @classmethod
+    def for_size(cls, width: int, height: int, **kw) -> World:
+        s = width / 320.0
+        return cls(Geometry(426.0 * s, 0.060, width / 2, height / 2), (width, height), **kw)
+
+    def nearest_box(self) -> Box:
+        return min(self.boxes, key=lambda b: b.z_m)
+
+    def project(self, x: float, y: float, z: float) -> tuple[float, float]:
+        """Left-image pixel of a world point (y up, relative to the floor)."""
+        g = self.geometry
+        return g.cx + g.focal_px * x / z, g.cy + g.focal_px * (self.height_m - y) / z
+
+    def marker_truth(self) -> tuple[float, float, float]:
+        """(left column, row, disparity) of the marker centre, exactly."""
+        r = self.robot
+        u, v = self.project(r.x_m, r.marker_height_m, r.z_m)
+        return u, v, self.geometry.focal_px * self.geometry.baseline_m / r.z_m
+
+    def step(self, dt: float, duty_left: float, duty_right: float) -> None:
+        """Move the robot for dt seconds under the duties its wheels get (permille), through
+        the motor faults: gain and offset per wheel, battery sag with distance, wheel slip."""
+        r, m, f = self.robot, self.motors, self.motor_faults
+        self.t += dt
+        a = 1.0 - math.exp(-dt / m.tau_s)
+        supply = max(0.5, 1.0 - f.sag_per_m * self.travelled_m)
+        targets = []
+        for duty, gain, offset in ((duty_left, f.gain[0], f.offset[0]),
+                                   (duty_right, f.gain[1], f.offset[1])):
+            v = m.speed(duty * supply - math.copysign(offset, duty) if duty else 0.0) * gain
+            if f.slip and v:
+                v *= 1.0 - f.slip * float(self.rng.random())
+            targets.append(v)
+        r.v_left += (targets[0] - r.v_left) * a
+        r.v_right += (targets[1] - r.v_right) * a
+        v = (r.v_left + r.v_right) / 2
+        r.theta += (r.v_left - r.v_right) / m.wheelbase_m * dt
+        r.x_m += (v * math.sin(r.theta) + f.push_mps) * dt
+        r.z_m += v * math.cos(r.theta) * dt
+        self.travelled_m += abs(v) * dt

@@ -1,0 +1,72 @@
+"""The target kept true during the run, and time taken from the frames' capture timestamps:
+a box pushed nearer mid-run is followed; frames that were captured long apart stop the robot
+even when the processing clock runs steadily; a pair whose two views are captured too far apart
+is not used."""
+
+from __future__ import annotations
+
+import pytest
+
+from host.camera.source import StereoFrame
+from host.sim.faults import Event, WorldFaults
+from host.sim.run import Setup, simulation
+
+
+def test_target_moved_mid_run_is_followed() -> None:
+    """The nearest box moves from 1.2 m to 1.0 m while the robot drives: it ends at 1.0 m."""
+    faults = WorldFaults(events=(Event(1.5, "move", 0, z_m=1.0),))
+    with simulation(Setup((320, 240), 0.6, faults=faults)) as sim:
+        sim.run(4.0, settle=None)  # past the move and a re-measure or two
+        sim.run(25.0)
+        assert sim.world.nearest_box().z_m == 1.0
+        assert sim.servo.outcome() == ("held", "")
+        assert sim.servo.target_m == pytest.approx(1.0, abs=0.015)
+        assert abs(sim.world.robot.z_m - 1.0) <= 0.02
+
+
+def test_target_that_vanishes_stops_the_run_with_its_reason() -> None:
+    faults = WorldFaults(events=(Event(1.0, "vanish", 0),))
+    with simulation(Setup((320, 240), 0.8, faults=faults)) as sim:
+        sim.run(6.0)
+        assert sim.servo.stop_reason == "target vanished"
+        assert sim.servo.outcome() == ("stopped", "target vanished")
+        assert sim.emulator.motors() == (0, 0)
+
+
+class Steady:
+    """A processing clock that ticks one frame period per call, whatever the camera does."""
+
+    def __init__(self) -> None:
+        self.t = 100.0
+
+    def __call__(self) -> float:
+        self.t += 1 / 30
+        return self.t
+
+
+def test_a_gap_between_capture_times_is_stale_even_on_a_steady_processing_clock() -> None:
+    with simulation(Setup((320, 240), 0.7)) as sim:
+        sim.servo.clock = Steady()
+        for _ in range(20):
+            row = sim.servo.step()
+        assert row.phase in ("drive", "creep") and sim.emulator.motors() != (0, 0)
+        sim.source.run_ms(400)  # the camera delivers nothing for 0.4 s; the robot drives on
+        row = sim.servo.step()
+        assert row.phase == "stale" and row.reason == "stale"
+        assert (row.left, row.right) == (0, 0) and sim.emulator.motors() == (0, 0)
+
+
+def test_a_pair_captured_too_far_apart_is_not_used() -> None:
+    with simulation(Setup((320, 240), 0.7)) as sim:
+        for _ in range(20):
+            row = sim.servo.step()
+        assert row.phase in ("drive", "creep")
+        read = sim.source.read
+
+        def skewed() -> StereoFrame:
+            f = read()
+            return StereoFrame(f.left, f.right, f.t_left, f.t_left + 0.06)
+
+        sim.source.read = skewed
+        row = sim.servo.step()
+        assert row.reason == "skew" and (row.left, row.right) == (0, 0)
