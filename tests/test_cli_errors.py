@@ -266,7 +266,7 @@ def test_sigterm_during_tune_is_an_interruption_that_writes_nothing(tmp_path: Pa
     out = tmp_path / "t.toml"
     try:
         timer.start()
-        code = main(["tune", "--method", "grid", "--windows", "5:61", "--out", str(out)])
+        code = main(["tune", "--space", "sad", "--method", "grid", "--out", str(out)])  # minutes
     finally:
         timer.cancel()
         signal.signal(signal.SIGTERM, guard)

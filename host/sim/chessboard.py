@@ -77,5 +77,4 @@ def calibrate_camera(world: World, camera: CameraFaults, seed: int = 0,
                 found.append(frame)
         if len(found) >= pairs:
             break
-    calib, _ = calibrate(found[:pairs], BOARD, SQUARE_MM)
-    return calib
+    return calibrate(found[:pairs], BOARD, SQUARE_MM).calibration

@@ -38,7 +38,7 @@ def test_missing_port_and_bad_camera_are_one_line_errors(tmp_path: Path) -> None
     r = run("--camera", "sim", "--port", "/dev/ttyNOPE0")
     assert r.returncode == 2 and "needs --port emulator" in r.stderr
     r = run("--sim", "--drop", "1.5")
-    assert r.returncode == 2 and "--drop must be a probability" in r.stderr
+    assert r.returncode == 2 and "argument --drop: must be >= 0 and <= 1" in r.stderr
 
 
 def test_link_fault_options_reach_the_simulated_robot() -> None:

@@ -17,7 +17,10 @@ def snapshot(t: float = 1.0, robot_px: float = 20.0, phase: str = "drive") -> Sn
     left = np.full((240, 320, 3), 90, np.uint8)
     disp = np.full((240, 320), 12.0, np.float32)
     disp[:, :20] = np.nan  # the left border has no disparity
-    row = LogRow(t, phase, 21.3, robot_px, robot_px, robot_px - 21.3, 300, 310, 30.0, 4.0)
+    depth = GEOMETRY.depth_m(robot_px)
+    target_m = GEOMETRY.depth_m(21.3)
+    row = LogRow(t, phase, "", target_m, depth, depth - target_m, 21.3, robot_px, robot_px, 300,
+                 310, 30.0, 4.0, 0.0)
     return Snapshot(t, phase, "", left, disp, 0, Target(21.3, 900, (100, 60, 40, 50), 0.3),
                     MarkerPair(Blob(200.0, 150.0, 6.0), Blob(200.0 - robot_px, 150.0, 6.0)),
                     row, LinkStats(1.5, 2, 1, 0, "power on", 0, 0xB0CE5B41), GEOMETRY)
