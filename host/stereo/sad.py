@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from host.stereo.block_matching import _argmin  # the first minimum over candidates kmin..nd
 from host.stereo.subpixel import FIT_NONE, fit_offset
 
 TILE_BYTES = 8192  # column sums updated per tile: well inside a 32 KiB L1 with the pixel rows
@@ -107,17 +108,6 @@ def _decide(win, best, kmin, nd, uniqueness, fit):
     return fit_offset(np.float32(win[best - 1]), c0, np.float32(win[best + 1]), fit), True
 
 
-@njit(cache=True, fastmath=True)
-def _first_min(win, kmin, nd):
-    m = win[kmin]
-    for k in range(kmin + 1, nd):
-        m = min(m, win[k])
-    best = kmin
-    while win[best] != m:
-        best += 1
-    return best
-
-
 @njit(cache=True, fastmath=True, inline="always")
 def _interior(col, win, idx, out, yi, x_from, x_to, half, dmin, nd, fit):
     """The common case: both window columns inside, every candidate allowed, no uniqueness.
@@ -176,7 +166,7 @@ def _row_outputs(col, win, zero, idx, rowcost, out, yi, x_from, x_to, x_start, h
                 if want_right:
                     rowcost[x - 1, :] = top
                 continue
-            k = _first_min(win, kmin, nd)
+            k = _argmin(win, kmin, nd)
         if want_right:
             rowcost[x - 1, :] = win
             rowcost[x - 1, :kmin] = top
@@ -197,7 +187,7 @@ def _right_row(rowcost, disp_r, y, w, x_start, x_end, dmin, nd, top, fit):
             any_valid = any_valid or c[k] != top
         if not any_valid:
             continue
-        k = _first_min(c, 0, nd)
+        k = _argmin(c, 0, nd)
         off, _ = _decide(c, k, 0, nd, 0.0, fit)
         disp_r[y, xr] = dmin + nd - 1 - k - off
 
