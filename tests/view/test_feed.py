@@ -40,7 +40,7 @@ def test_a_slow_page_gets_the_latest_and_the_rest_are_counted_dropped():
                     seq = update.seq
                     got.append(update)
 
-        reader = threading.Thread(target=page)
+        reader = threading.Thread(target=page, daemon=True)  # a failed test must not hang pytest
         reader.start()
         worst = 0.0
         for i in range(300):  # a 300 Hz loop against a page of at most 10 updates a second
