@@ -109,12 +109,6 @@ def _hyper(args: argparse.Namespace) -> dict[str, Any]:
         raise HostError("--alpha and --episodes belong to --method qlearning")
     if args.method in ("grid", "random", "tpe") and set(hyper) - {"step"}:
         raise HostError(f"--method {args.method} takes no learning parameters")
-    if args.step < 1 or (args.episodes is not None and args.episodes < 1):
-        raise HostError("--step and --episodes must be at least 1")
-    for name in ("alpha", "gamma", "epsilon"):
-        value = getattr(args, name)
-        if value is not None and not 0.0 <= value <= 1.0:
-            raise HostError(f"--{name} must be in [0, 1], got {value}")
     return hyper
 
 
@@ -122,8 +116,6 @@ def _check_args(args: argparse.Namespace) -> int:
     iterations = DEFAULT_ITERATIONS[args.method] if args.iterations is None else args.iterations
     if args.method != "grid" and iterations < 1:
         raise HostError(f"--iterations must be at least 1, got {iterations}")
-    if args.workers < 1:
-        raise HostError(f"--workers must be at least 1, got {args.workers}")
     if args.ray is not None:
         if args.workers > 1:
             raise HostError("--workers and --ray are two ways to run evaluations: pick one")
@@ -142,8 +134,6 @@ def _camera_scenes(args: argparse.Namespace) -> tuple[list[Scene], float | None]
     geometry is known (calibration or simulation)."""
     from host.tuning.frames import sim_pairs, spread_pairs
 
-    if args.frames < 1:
-        raise HostError(f"--frames must be at least 1, got {args.frames}")
     focal_baseline = None
     if args.camera == "sim":
         pairs, focal_baseline = sim_pairs(*parse_size(args.size), args.frames)
