@@ -70,7 +70,11 @@ def main(out: Path) -> None:
             browser = pw.chromium.launch(executable_path=CHROMIUM, headless=True, args=FLAGS)
             page = browser.new_page(viewport={"width": 1280, "height": 900})
             page.goto(url)
-            page.wait_for_function("+(document.body.dataset.updates || 0) >= 1", timeout=30000)
+            # images decode asynchronously after an update: wait for both, not for the update alone
+            page.wait_for_function(
+                "+(document.body.dataset.updates || 0) >= 1 && "
+                "document.getElementById('left').naturalWidth > 0 && "
+                "document.getElementById('disparity').naturalWidth > 0", timeout=30000)
             result["samples"].append(read_dom(page))
             # on until the robot is seen and driven, and its depth has been plotted a while
             page.wait_for_function(
