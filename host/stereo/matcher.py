@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import contextlib
 import threading
+from collections.abc import Iterator
 
 import cv2
 import numba
@@ -19,6 +21,21 @@ from host.stereo.subpixel import DEFAULT_FITS, FIT_NONE, FITS
 
 SGM_P1 = 8  # default SGM penalties per pixel of the cost box (census bits)
 SGM_P2 = 32
+# pixel-disparities (about 1.5 ms of SAD on one core) below which a match runs on the calling
+# thread alone: waking numba's thread pool costs more than it saves there, and on a loaded
+# machine a sleeping worker took 7-40 ms to join a 0.2 ms match of the servo's marker window
+SERIAL_WORK = 1 << 21
+
+
+@contextlib.contextmanager
+def numba_threads(n: int) -> Iterator[None]:
+    """numba's thread count for kernels called from this thread (it is per thread) inside."""
+    before = numba.get_num_threads()
+    numba.set_num_threads(n)
+    try:
+        yield
+    finally:
+        numba.set_num_threads(before)
 
 
 def _box_sums(img: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray]:
@@ -77,11 +94,13 @@ def sad_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
     pl, pr = _planes(left, p.colour), _planes(right, p.colour)
     cdt, wdt = sad.lane_types(pl.shape[0], p.block_size)
     want_right = p.lr_check is not None
-    disp_l, disp_r = sad.match_sad(pl, pr, p.min_disparity, p.num_disparities,
-                                   p.block_size // 2, float(p.uniqueness_ratio),
-                                   subpixel_fit(p), want_right, p.border == "clip",
-                                   np.empty(0, cdt), np.empty(0, wdt), np.iinfo(wdt).max,
-                                    numba.get_num_threads())
+    work = pl.shape[1] * pl.shape[2] * p.num_disparities
+    n = 1 if work < SERIAL_WORK else numba.get_num_threads()
+    with numba_threads(n):
+        disp_l, disp_r = sad.match_sad(pl, pr, p.min_disparity, p.num_disparities,
+                                       p.block_size // 2, float(p.uniqueness_ratio),
+                                       subpixel_fit(p), want_right, p.border == "clip",
+                                       np.empty(0, cdt), np.empty(0, wdt), np.iinfo(wdt).max, n)
     if want_right:
         disp_l = lr_consistency(disp_l, disp_r, float(p.lr_check))
     return disp_l
