@@ -9,9 +9,10 @@
                      the marker with the search range set around it (min-disp / num-disp follow
                      the marker, so near range is not cut off) -> depth (m) -> Controller ->
                      SET_DRIVE or STOP over the link
-    every remeasure_s the target is measured again outside the robot's own image region: it
-    follows the object when it moves, retargets when a nearer object appears, and the run stops
-    ("target vanished") when nothing is left where it was.
+    every remeasure_s the target is measured again outside the robot's own image region (on a
+    whole map matched a band of rows per frame, StripMap): it follows the object when it moves,
+    retargets when a nearer object appears, and the run stops ("target vanished") when nothing is
+    left where it was.
 
 Time comes from the frames' capture timestamps: a frame whose capture follows the previous one by
 more than stale_s, or that arrives stale_s later than frames usually do, is stale; a pair whose
@@ -36,6 +37,7 @@ from host.servo.controller import Command, ControlConfig, Controller, Observatio
 from host.servo.marker import MarkerPair, block_disparity, find_marker
 from host.servo.perception import (
     Floor,
+    StripMap,
     Target,
     match_exposure,
     nearest_object,
@@ -111,6 +113,7 @@ class Servo:
         self._measuring = noise_frames > 1
         self._target_history: list[float] = []
         self._remeasure_t: float | None = None
+        self._strips: StripMap | None = None  # the re-measure's map, a band per frame
         self._doubt = (0, "")  # consecutive re-measures that disagree, and how
         self._prev: tuple[float, float, float] | None = None  # t_right, right u, skew-free d
         self._latency_floor: float | None = None
@@ -152,6 +155,7 @@ class Servo:
             self.link.stop()  # keeps the link alive while the robot waits
         h, w = disps[0].shape
         self.min_area = self.min_area or (w * h) // 100
+        self._strips = StripMap(self.params, (h, w))
         self.target, self.floor = reference_target(disps, self.min_area)
         self._target_history = [self.target.disparity] * 2
         self.controller = Controller(self.geometry.depth_m(self.target.disparity), self.control)
@@ -226,13 +230,10 @@ class Servo:
         return (max(0, int(u - half)), max(0, int(v - 2 * r)), min(w, int(u + half) + 1),
                 min(h, int(v + self.robot_below_marker_m * ppm) + 1))
 
-    def _remeasure(self, frame: StereoFrame, pair: MarkerPair | None) -> None:
-        """Measure the nearest object again, the robot's region left out; follow it."""
+    def _remeasure(self, disp: np.ndarray) -> None:
+        """Measure the nearest object again on the whole map disp (the robot's region NaN);
+        follow it."""
         assert self.target is not None and self.controller is not None
-        disp = compute_disparity(frame.left, frame.right, self.params)
-        if pair is not None:
-            x0, y0, x1, y1 = self._robot_region(pair, disp.shape)
-            disp[y0:y1, x0:x1] = np.nan
         disp = without_floor(disp, self.floor)
         old = self.target
         bx, by, bw, bh = old.bbox
@@ -241,7 +242,7 @@ class Servo:
         if there.size < self.min_area // 4:
             return  # the robot hides the object: nothing to learn
         try:
-            found: Target | None = nearest_object(disp, self.min_area)
+            found: Target | None = nearest_object(disp, self.min_area, near=old.disparity)
         except HostError:
             found = None
         overlap = found is not None and min(bx + bw, found.bbox[0] + found.bbox[2]) - max(
@@ -301,6 +302,7 @@ class Servo:
     def step(self, truth_depth_m: float = math.nan) -> LogRow:
         """One frame of the robot phase: perceive, decide, command, log."""
         assert self.controller is not None and self.target is not None
+        assert self._strips is not None
         last = self.rows[-1] if self.rows else None
         frame = self._frame()
         t_wall = time.perf_counter()
@@ -320,10 +322,17 @@ class Servo:
                 self.last_pair = pair
                 robot = self._skew_corrected(frame, pair)
                 lateral = self.geometry.baseline_m * (pair.left.u - self.geometry.cx) / robot
-        if self._remeasure_t is None or frame.t_left - self._remeasure_t >= self.remeasure_s:
+        due = self._remeasure_t is None or frame.t_left - self._remeasure_t >= self.remeasure_s
+        if due:
             self._remeasure_t = frame.t_left
-            if self.controller.phase != "turn":
-                self._remeasure(frame, pair)
+        if due or self._strips.busy:  # a band of the re-measure's map each frame, then the map
+            if self.controller.phase == "turn":
+                self._strips.reset()
+            else:
+                hide = None if pair is None else self._robot_region(pair, frame.left.shape)
+                whole = self._strips.add(frame.left, frame.right, hide)
+                if whole is not None:
+                    self._remeasure(whole)
         seen = pair is not None and not invalid
         stop_reason = self.stop_reason  # read once: a STOP requested meanwhile acts next frame
         if stop_reason:

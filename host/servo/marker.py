@@ -61,9 +61,8 @@ def find_discs(image: np.ndarray, min_radius: float = 2.5, max_radius: float = 8
     local = cv2.blur(grey, (window, window))
     mask = (grey.astype(np.int16) < local.astype(np.int16) - 40).astype(np.uint8)
     mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, np.ones((2, 2), np.uint8))
-    contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
     blobs = []
-    for c in contours:
+    for c in _outlines(mask, math.pi * min_radius ** 2):
         area = cv2.contourArea(c)
         if area < math.pi * min_radius ** 2 or area > math.pi * max_radius ** 2:
             continue
@@ -84,6 +83,15 @@ def find_discs(image: np.ndarray, min_radius: float = 2.5, max_radius: float = 8
         aspect = math.sqrt(m["mu20"] / m["mu02"]) if m["mu02"] > 0 else 1.0
         blobs.append(Blob(u, v, r, aspect))
     return blobs
+
+
+def _outlines(mask: np.ndarray, min_area: float) -> list[np.ndarray]:
+    """The outer contours of the mask's blobs that could enclose min_area px: a textured scene
+    leaves thousands of specks. A closed contour of n points (steps of at most sqrt 2 px)
+    encloses at most (n sqrt 2)^2 / (4 pi) px, so shorter ones are dropped unmeasured."""
+    contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    shortest = math.sqrt(2 * math.pi * min_area)
+    return [c for c in contours if len(c) >= shortest]
 
 
 def _annulus_stats(grey: np.ndarray, cx: float, cy: float, r0: float, r1: float
@@ -121,8 +129,10 @@ def find_markers(left: np.ndarray, right: np.ndarray, kind: str = "disc",
     def find(img: np.ndarray) -> list[Blob]:
         return find_aruco(img) if kind == "aruco" else find_discs(img, window=window)
 
-    found = []
+    found: list[list[Blob]] = []
     for img, win in zip((left, right), windows or (None, None)):
+        if found and not found[0]:
+            return []  # nothing on the left: no pair, whatever the right view holds
         if win is None:
             found.append(find(img))
             continue
