@@ -1,63 +1,129 @@
-"""Benchmark of the servo loop on this machine: loop rate and frame-to-command latency (frame
-arrival to the command acknowledged by the robot) at 320x240 and 640x480 with 64 disparities,
-the emulator on a pty at 115200 baud in real time. Rendering the simulated frames is not
-counted: a camera delivers them. Two ways of using the matcher each frame: a window around the
-marker (the cross-check the loop needs, its search range set around the marker's disparity)
-and the whole disparity map; both include the target's re-measure (a whole map once a second).
-Record `uptime` beside the figures: the machine may be shared."""
+"""Benchmark of the servo loop a user runs: `host servo --sim` with the defaults (own SAD,
+window 9, 64 disparities) at 320x240 and 640x480, one whole run each (measure, turn, drive,
+creep, hold and the target's re-measures; the reference phase not counted). Per size: frames
+per second the processing allows (frames / summed frame-to-command time) and the frame-to-
+command latency (frame arrival to the command acknowledged by the robot) p50 / p95 / max.
+Rendering is not counted (a camera delivers the frames); the robot is the firmware's core on a
+pty in lockstep, so the 1.9 ms a SET_DRIVE and its ACK take on a 115200-baud wire
+(bench/link.py) is not in the latency.
+
+The machine may be shared: beside each figure stand the load average before and after, the
+threads, and cv2.StereoBM (64 disparities, window 9) on the whole 640x480 frame, timed in the
+same process between the servo's frames, with the ratio of the two.
+
+    bench/servo.py [FRAMES] [--stages]    FRAMES: most frames per run (default 450);
+                                          --stages: where each frame's milliseconds go
+"""
 
 from __future__ import annotations
 
+import functools
+import os
 import statistics
 import sys
+import time
+from collections import Counter
+from collections.abc import Callable
 
-from host.emulator.emulator import Emulator, PtyService
-from host.link.client import RobotLink
-from host.servo.loop import Servo
-from host.sim.source import SimSource
+import cv2
+import numba
+
+from host.servo import loop
+from host.servo.perception import StripMap
+from host.sim.renderer import Renderer
+from host.sim.run import Setup, simulation
 from host.sim.world import World
 from host.stereo import MatcherParams
-from host.stereo.matcher import warm_up
+from host.stereo.matcher import SERIAL_WORK, warm_up
 
-FRAMES = int(sys.argv[1]) if len(sys.argv) > 1 else 150
-
-
-def measure(size: tuple[int, int], params: MatcherParams, full_map: bool) -> tuple[float, ...]:
-    world = World.for_size(*size)
-    world.robot.z_m = 2.0
-    emulator = Emulator()
-    with PtyService(emulator, realtime=True) as service, RobotLink(service.path) as link:
-        # the simulated camera steps its own copy of the world; the robot here only answers
-        source = SimSource(world, Emulator(line_rate=False), reference_frames=3)
-        servo = Servo(source, link, params, world.geometry, full_map=full_map)
-        servo.reference()
-        lat = []
-        t_busy = 0.0
-        for _ in range(FRAMES):
-            row = servo.step()
-            lat.append(row.latency_ms)
-            t_busy += row.latency_ms / 1000
-    lat.sort()
-    return statistics.median(lat), lat[int(0.95 * len(lat))], FRAMES / t_busy
+STAGES = {  # what the loop calls, by the name the table prints
+    "exposure": (loop, "match_exposure"),
+    "marker": (loop, "find_marker"),
+    "marker window match": (loop.Servo, "_robot_disparity"),
+    "re-measure band": (StripMap, "add"),
+    "re-measure analysis": (loop.Servo, "_remeasure"),
+    "control law": (loop.Controller, "update"),
+    "command + ACK": (loop.Servo, "_send"),
+}
 
 
-def main() -> int:
-    import os
+def _timed(f: Callable, times: list[float]) -> Callable:
+    @functools.wraps(f)
+    def wrapper(*args, **kwargs):
+        t0 = time.perf_counter()
+        try:
+            return f(*args, **kwargs)
+        finally:
+            times.append((time.perf_counter() - t0) * 1000)
+    return wrapper
 
-    print(f"load average {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} on "
-          f"{os.cpu_count()} cores")
-    params = MatcherParams(matcher="sad", block_size=9, num_disparities=64, border="clip")
-    warm_up(params)
-    print(f"matcher: {params.matcher}, window {params.block_size}, {params.num_disparities} "
-          f"disparities, colour off (the simulated camera is grey); {FRAMES} frames each")
+
+def _pct(values: list[float], q: float) -> float:
+    s = sorted(values)
+    return s[min(len(s) - 1, int(q * len(s)))]
+
+
+def run(size: tuple[int, int], frames: int, bm_every: int = 10) -> dict:
+    """One simulated run of the user's loop; StereoBM timed on the 640x480 frame every
+    bm_every frames."""
+    bm = cv2.StereoBM_create(64, 9)
+    world = World.for_size(640, 480)
+    world.robot.z_m = 1.9
+    bm_frame = Renderer(world).frame()
+    setup = Setup(size, params=MatcherParams().validate())
+    load0 = os.getloadavg()[0]
+    latency, bm_ms, phases = [], [], Counter()
+    with simulation(setup) as sim:
+        for i in range(frames):
+            sim.step()
+            row = sim.servo.rows[-1]
+            latency.append(row.latency_ms)
+            phases[row.phase] += 1
+            if i % bm_every == 0:
+                t0 = time.perf_counter()
+                bm.compute(bm_frame.left, bm_frame.right)
+                bm_ms.append((time.perf_counter() - t0) * 1000)
+            if sim.servo.stop_reason or sim.servo.held_for(1.0):
+                break
+        outcome = sim.servo.outcome()
+    return {"latency": latency, "bm": bm_ms, "phases": phases, "outcome": outcome,
+            "load": (load0, os.getloadavg()[0])}
+
+
+def main(argv: list[str]) -> int:
+    frames = int(next((a for a in argv if a.isdigit()), 450))
+    stages: dict[str, list[float]] = {}
+    if "--stages" in argv:
+        for name, (owner, attr) in STAGES.items():
+            stages[name] = []
+            setattr(owner, attr, _timed(getattr(owner, attr), stages[name]))
+    warm_up(MatcherParams())
+    print(f"servo loop, `host servo --sim` defaults (SAD window 9, 64 disparities, nominal "
+          f"world, start 1.9 m), {os.cpu_count()} cores; numba {numba.get_num_threads()} "
+          f"threads (matches under {SERIAL_WORK / 1e6:.1f} M pixel-disparities and the "
+          f"re-measure's bands on the loop's own thread), OpenCV {cv2.getNumThreads()} threads")
     for size in ((320, 240), (640, 480)):
-        for full in (False, True):
-            med, p95, hz = measure(size, params, full)
-            what = "whole map  " if full else "marker band"
-            print(f"  {size[0]}x{size[1]} {what}: frame-to-command median {med:5.1f} ms, "
-                  f"p95 {p95:5.1f} ms; loop rate the processing allows {hz:6.1f} Hz")
+        for times in stages.values():
+            times.clear()
+        r = run(size, frames)
+        lat, bm = r["latency"], statistics.median(r["bm"])
+        mean = sum(lat) / len(lat)
+        phases = ", ".join(f"{k} {v}" for k, v in r["phases"].items())
+        print(f"  {size[0]}x{size[1]}: {1000 / mean:6.1f} frames/s of processing (mean "
+              f"{mean:.1f} ms); frame-to-command p50 {statistics.median(lat):.1f} ms, p95 "
+              f"{_pct(lat, 0.95):.1f} ms, max {max(lat):.1f} ms; load {r['load'][0]:.2f} -> "
+              f"{r['load'][1]:.2f}")
+        print(f"      same process: cv2.StereoBM on the whole 640x480 frame {bm:.1f} ms "
+              f"(median of {len(r['bm'])}); a servo frame costs {mean / bm:.2f} StereoBM "
+              f"frames")
+        print(f"      {len(lat)} frames ({phases}); {r['outcome'][0]} {r['outcome'][1]}")
+        for name, times in stages.items():
+            if times:
+                print(f"      {name:<20} {len(times):4d} calls, p50 {statistics.median(times):6.2f}"
+                      f" ms, p95 {_pct(times, 0.95):6.2f} ms, max {max(times):6.2f} ms, "
+                      f"{sum(times) / len(lat):5.2f} ms a frame")
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(main(sys.argv[1:]))

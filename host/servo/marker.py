@@ -62,15 +62,17 @@ def find_discs(image: np.ndarray, min_radius: float = 2.5, max_radius: float = 8
     mask = (grey.astype(np.int16) < local.astype(np.int16) - 40).astype(np.uint8)
     mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, np.ones((2, 2), np.uint8))
     blobs = []
-    for c in _outlines(mask, math.pi * min_radius ** 2):
+    min_area = math.pi * min_radius ** 2
+    for c in _outlines(mask, min_area):
+        # the cheapest tests first; the contour's area is at most (w - 1)(h - 1)
+        x, y, w, h = cv2.boundingRect(c)
+        if not 0.75 < w / h < 1.33 or (w - 1) * (h - 1) < min_area:
+            continue
         area = cv2.contourArea(c)
-        if area < math.pi * min_radius ** 2 or area > math.pi * max_radius ** 2:
+        if area < min_area or area > math.pi * max_radius ** 2:
             continue
         perimeter = cv2.arcLength(c, True)
         if perimeter <= 0 or 4 * math.pi * area / perimeter ** 2 < 0.7:
-            continue
-        x, y, w, h = cv2.boundingRect(c)
-        if not 0.75 < w / h < 1.33:
             continue
         r = (w + h) / 4
         u, v = _centroid(grey, x + (w - 1) / 2, y + (h - 1) / 2, r)
