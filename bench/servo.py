@@ -1,8 +1,9 @@
 """Benchmark of the servo loop a user runs: `host servo --sim` with the defaults (own SAD,
 window 9, 64 disparities) at 320x240 and 640x480, one whole run each (measure, turn, drive,
 creep, hold and the target's re-measures; the reference phase not counted). Per size: frames
-per second the processing allows (frames / summed frame-to-command time) and the frame-to-
-command latency (frame arrival to the command acknowledged by the robot) p50 / p95 / max.
+per second the processing allows (frames / summed frame-to-command time), the frame-to-command
+latency (frame arrival to the command acknowledged by the robot) p50 / p95 / max, and the CPU
+time the loop's thread spent on the same span (what a free core would need, whatever the load).
 Rendering is not counted (a camera delivers the frames); the robot is the firmware's core on a
 pty in lockstep, so the 1.9 ms a SET_DRIVE and its ACK take on a 115200-baud wire
 (bench/link.py) is not in the latency.
@@ -63,7 +64,7 @@ def _pct(values: list[float], q: float) -> float:
     return s[min(len(s) - 1, int(q * len(s)))]
 
 
-def run(size: tuple[int, int], frames: int, bm_every: int = 10) -> dict:
+def run(size: tuple[int, int], frames: int, bm_every: int = 5) -> dict:
     """One simulated run of the user's loop; StereoBM timed on the 640x480 frame every
     bm_every frames."""
     bm = cv2.StereoBM_create(64, 9)
@@ -72,10 +73,22 @@ def run(size: tuple[int, int], frames: int, bm_every: int = 10) -> dict:
     bm_frame = Renderer(world).frame()
     setup = Setup(size, params=MatcherParams().validate())
     load0 = os.getloadavg()[0]
-    latency, bm_ms, phases = [], [], Counter()
+    latency, cpu, bm_ms, phases = [], [], [], Counter()
     with simulation(setup) as sim:
+        read, reading = sim.servo._frame, [0.0]
+
+        def timed_read():  # rendering the frame is the camera's work, not the loop's
+            t0 = time.thread_time()
+            try:
+                return read()
+            finally:
+                reading[0] = time.thread_time() - t0
+
+        sim.servo._frame = timed_read
         for i in range(frames):
+            t0 = time.thread_time()
             sim.step()
+            cpu.append((time.thread_time() - t0 - reading[0]) * 1000)
             row = sim.servo.rows[-1]
             latency.append(row.latency_ms)
             phases[row.phase] += 1
@@ -86,7 +99,7 @@ def run(size: tuple[int, int], frames: int, bm_every: int = 10) -> dict:
             if sim.servo.stop_reason or sim.servo.held_for(1.0):
                 break
         outcome = sim.servo.outcome()
-    return {"latency": latency, "bm": bm_ms, "phases": phases, "outcome": outcome,
+    return {"latency": latency, "cpu": cpu, "bm": bm_ms, "phases": phases, "outcome": outcome,
             "load": (load0, os.getloadavg()[0])}
 
 
@@ -113,10 +126,14 @@ def main(argv: list[str]) -> int:
               f"{mean:.1f} ms); frame-to-command p50 {statistics.median(lat):.1f} ms, p95 "
               f"{_pct(lat, 0.95):.1f} ms, max {max(lat):.1f} ms; load {r['load'][0]:.2f} -> "
               f"{r['load'][1]:.2f}")
+        cpu = r["cpu"]
+        print(f"      CPU of the loop's thread a frame: p50 {statistics.median(cpu):.1f} ms, p95 "
+              f"{_pct(cpu, 0.95):.1f} ms, mean {sum(cpu) / len(cpu):.1f} ms: "
+              f"{1000 * len(cpu) / sum(cpu):.0f} frames/s on a free core")
         print(f"      same process: cv2.StereoBM on the whole 640x480 frame {bm:.1f} ms "
               f"(median of {len(r['bm'])}); a servo frame costs {mean / bm:.2f} StereoBM "
               f"frames")
-        print(f"      {len(lat)} frames ({phases}); {r['outcome'][0]} {r['outcome'][1]}")
+        print(f"      {len(lat)} frames ({phases}); {': '.join(filter(None, r['outcome']))}")
         for name, times in stages.items():
             if times:
                 print(f"      {name:<20} {len(times):4d} calls, p50 {statistics.median(times):6.2f}"
