@@ -127,7 +127,8 @@ def main(argv: list[str]) -> int:
         print(f"  {size[0]}x{size[1]}: {1000 / mean:6.1f} frames/s of processing (mean "
               f"{mean:.1f} ms); frame-to-command p50 {statistics.median(lat):.1f} ms, p95 "
               f"{_pct(lat, 0.95):.1f} ms, max {max(lat):.1f} ms; load {r['load'][0]:.2f} -> "
-              f"{r['load'][1]:.2f}")
+              f"{r['load'][1]:.2f}, numba {numba.get_num_threads()} threads, OpenCV "
+              f"{cv2.getNumThreads()}")
         cpu = r["cpu"]
         print(f"      CPU of the loop's thread a frame: p50 {statistics.median(cpu):.1f} ms, p95 "
               f"{_pct(cpu, 0.95):.1f} ms, mean {sum(cpu) / len(cpu):.1f} ms: "
