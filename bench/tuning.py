@@ -9,6 +9,8 @@ evaluated once (optionally cached on disk) and the rest is read from those table
 Each scene gets its disparity range from a policy (ground truth + 4 px; the self-supervised
 runs use the coarse pass, as a robot would), never a tuned number.
 Run: .venv/bin/python bench/tuning.py [--cache DIR] [--scenes a,b,...] [--workers N]
+(--cache also keeps every state's disparity maps for the self-supervised section, ~2 GB, so a
+changed objective is re-scored without matching: delete its self-terms-*.json.)
 """
 
 from __future__ import annotations
@@ -25,13 +27,14 @@ from pathlib import Path
 import numpy as np
 
 from host.stereo import MatcherParams
+from host.stereo.metrics import evaluate
 from host.stereo.scenes import Scene, load_scene
 from host.tuning.backends import make_backend
 from host.tuning.disparity_range import RangePolicy, apply_range
-from host.tuning.ground_truth import GroundTruthScore, scene_bad
+from host.tuning.ground_truth import GroundTruthScore
 from host.tuning.learners import tune
 from host.tuning.objective import Objective, SceneTable
-from host.tuning.self_supervised import TERMS, Weights, score_of, terms
+from host.tuning.self_supervised import TERMS, Weights, disparity_maps, score_of, terms_of_maps
 from host.tuning.spaces import Space, make_space
 
 BASE = MatcherParams(border="clip")
@@ -48,17 +51,37 @@ def conditions() -> str:
 
 
 class TermsAndTruth:
-    """params -> per scene: the self-supervised terms and the bad % of the same maps' range."""
+    """params -> per scene: the self-supervised terms and the bad % of the same maps' range.
 
-    def __init__(self, scenes: list[Scene], ranges) -> None:
-        self.scenes, self.ranges = scenes, ranges
+    With maps_dir the left and right disparity maps of each (scene, params) are kept there, so a
+    changed objective re-scores them without matching again (delete the self-terms table)."""
+
+    def __init__(self, scenes: list[Scene], ranges, maps_dir: Path | None = None) -> None:
+        self.scenes, self.ranges, self.maps_dir = scenes, ranges, maps_dir
+
+    def maps(self, s: Scene, p: MatcherParams) -> tuple[np.ndarray, np.ndarray]:
+        path = None
+        if self.maps_dir is not None:
+            key = hashlib.sha1(repr((s.name, p)).encode()).hexdigest()[:16]
+            path = self.maps_dir / f"{s.name}-{key}.npz"
+            if path.exists():
+                with np.load(path) as z:
+                    return z["left"], z["right"]
+        disp_l, disp_r = disparity_maps(s.left, s.right, p)
+        if path is not None:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            tmp = path.with_suffix(".part.npz")
+            np.savez(tmp, left=disp_l, right=disp_r)
+            tmp.replace(path)
+        return disp_l, disp_r
 
     def __call__(self, params: MatcherParams) -> list[float]:
         out: list[float] = []
         for s, r in zip(self.scenes, self.ranges):
-            p = apply_range(params, r)
-            t = terms(s.left, s.right, p)
-            out += [t[k] for k in TERMS] + [scene_bad(s, p)]
+            disp_l, disp_r = self.maps(s, apply_range(params, r))
+            t = terms_of_maps(s.left, s.right, disp_l, disp_r)
+            assert s.gt is not None
+            out += [t[k] for k in TERMS] + [evaluate(disp_l, s.gt, s.masks.get("nonocc")).bad]
         return out
 
 
@@ -156,8 +179,9 @@ def self_supervised(space: Space, names: list[str], scenes, gt_table: np.ndarray
     coarse = RangePolicy("coarse", 4.0)
     ranges = [coarse.resolve(s.left, s.right) for s in scenes]
     t0 = time.perf_counter()
-    raw = cached_table("self-terms", TermsAndTruth(scenes, ranges), space, scenes, ranges,
-                       cache, workers)
+    maps = cache / "maps" if cache else None
+    raw = cached_table(f"self-terms-{len(TERMS)}", TermsAndTruth(scenes, ranges, maps), space,
+                       scenes, ranges, cache, workers)
     print(f"\n== self-supervised objective on the {space.name} space (terms of {space.size} "
           f"states x {len(scenes)} scenes: {time.perf_counter() - t0:.0f} s, 0 when cached; "
           f"weights {Weights()}; ranges by the coarse pass)")

@@ -136,12 +136,18 @@ def _terms(disp_l: np.ndarray, disp_r: np.ndarray, cl: np.ndarray, cr: np.ndarra
             rough / max(pairs, 1))
 
 
-def terms(left: np.ndarray, right: np.ndarray, params: MatcherParams) -> dict[str, float]:
-    """The terms (fractions, 0 best) of the matcher's disparity for one rectified pair."""
+def disparity_maps(left: np.ndarray, right: np.ndarray, params: MatcherParams
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """The matcher's left disparity, and the right one from the mirrored pair."""
     disp_l = compute_disparity(left, right, params)
     mirrored = compute_disparity(np.ascontiguousarray(right[:, ::-1]),
                                  np.ascontiguousarray(left[:, ::-1]), params)
-    return terms_of_maps(left, right, disp_l, np.ascontiguousarray(mirrored[:, ::-1]))
+    return disp_l, np.ascontiguousarray(mirrored[:, ::-1])
+
+
+def terms(left: np.ndarray, right: np.ndarray, params: MatcherParams) -> dict[str, float]:
+    """The terms (fractions, 0 best) of the matcher's disparity for one rectified pair."""
+    return terms_of_maps(left, right, *disparity_maps(left, right, params))
 
 
 def terms_of_maps(left: np.ndarray, right: np.ndarray, disp_l: np.ndarray,
