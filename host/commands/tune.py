@@ -45,7 +45,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="scenes with ground truth (default: the embedded Motorcycle pair)")
     p.add_argument("--objective", choices=("gt", "self"), default="gt",
                    help="gt: bad %% against ground truth; self: self-supervised (census "
-                        "reconstruction, LR consistency, invalid, roughness), no ground truth")
+                        "reconstruction of the right view, holes, LR consistency, invalid, "
+                        "roughness), no ground truth")
     p.add_argument("--frames", type=COUNT, default=4, metavar="N",
                    help="--camera: tune on N pairs spread over what the camera gives")
     p.add_argument("--space", choices=SPACES, default="window",
@@ -72,7 +73,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--episodes", type=COUNT, help="qlearning: episodes (default 20)")
     p.add_argument("--range", dest="range_policy", metavar="POLICY",
                    help="each scene's disparity range: ground-truth (default), coarse (a quick "
-                        "quarter-size pass), depth:NEAR:FAR (m, needs a calibration) or fixed:N")
+                        "half-size pass), depth:NEAR:FAR (m, needs a calibration) or fixed:N")
     p.add_argument("--range-margin", type=NON_NEGATIVE, default=4.0, metavar="PX",
                    help="widen the derived range by this much on both sides (default 4 px)")
     cv = p.add_mutually_exclusive_group()

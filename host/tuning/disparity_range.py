@@ -3,8 +3,10 @@
 Policies (text form in brackets, as --range takes it and params files store it):
 - ground-truth [ground-truth]: the scene's known disparities, widened by the margin.
 - depth [depth:NEAR:FAR]: the calibration's depth range in metres, d = focal * baseline / Z.
-- coarse [coarse]: a quick ZNCC pass at quarter size with a left-right check; its 1st to 99th
-  percentile, scaled back up and widened by the margin.
+- coarse [coarse]: a quick ZNCC pass at half size over half the image width, with a left-right
+  and uniqueness check; of its confident matches (away from the border, agreeing with most of
+  their 5x5 neighbours) the 0.5th to 99.5th percentile, scaled back up, widened by one coarse
+  pixel and the margin.
 - fixed [fixed:N]: disparities 0..N-1 (for a user who knows the rig).
 A range is (min_disparity, num_disparities) in px, as MatcherParams takes them.
 """
@@ -21,7 +23,10 @@ import numpy as np
 from host.errors import HostError
 
 KINDS = ("ground-truth", "depth", "coarse", "fixed")
-COARSE_FACTOR = 4
+COARSE_FACTOR = 2
+COARSE_WINDOW = 7  # px at half size
+COARSE_SUPPORT = 16  # of the 24 neighbours in 5x5 within 1 coarse px: not a speckle
+COARSE_PERCENTILES = (0.5, 99.5)
 
 
 @dataclass(frozen=True)
@@ -117,22 +122,43 @@ def _round_up(n: int, multiple: int) -> int:
 
 
 def coarse_range(left: np.ndarray, right: np.ndarray) -> tuple[float, float]:
-    """(low, high) disparity in full-size px from a quick quarter-size ZNCC pass."""
+    """(low, high) disparity in full-size px from a quick half-size ZNCC pass.
+
+    Only confident matches count: left-right consistent, unique, inside the image by the window,
+    and supported by at least COARSE_SUPPORT of their 24 neighbours (within 1 coarse px), so that
+    the speckles of wrong matches, which spread over the whole search, do not widen the range;
+    the matcher's border pixels (which clip to disparity 0) are left out too."""
     from host.stereo.matcher import compute_disparity
     from host.stereo.params import MatcherParams
 
     f = COARSE_FACTOR
     small = [cv2.resize(im, (im.shape[1] // f, im.shape[0] // f), interpolation=cv2.INTER_AREA)
              for im in (left, right)]
-    width = small[0].shape[1]
-    p = MatcherParams(matcher="ncc", block_size=5, num_disparities=max(4, width // 3),
-                      border="clip", lr_check=1.0, uniqueness_ratio=5.0)
+    h, width = small[0].shape[:2]
+    p = MatcherParams(matcher="ncc", block_size=COARSE_WINDOW, num_disparities=max(4, width // 2),
+                      border="clip", lr_check=1.0, uniqueness_ratio=10.0)
     disp = compute_disparity(small[0], small[1], p)
-    valid = disp[np.isfinite(disp)]
-    if valid.size < 0.05 * disp.size:
-        return 0.0, float(width // 3 * f)  # featureless: search the whole coarse range
-    lo, hi = np.percentile(valid, (1, 99))
+    confident = np.isfinite(disp) & (_support(disp) >= COARSE_SUPPORT)
+    r = COARSE_WINDOW // 2 + 1
+    confident[:r] = confident[h - r:] = False
+    confident[:, :r] = confident[:, width - r:] = False
+    if confident.sum() < 0.05 * disp.size:
+        return 0.0, float(width // 2 * f)  # featureless: search the whole coarse range
+    lo, hi = np.percentile(disp[confident], COARSE_PERCENTILES)
     return float(lo * f - f), float(hi * f + f)
+
+
+def _support(disp: np.ndarray) -> np.ndarray:
+    """How many of each pixel's 24 neighbours in 5x5 have a disparity within 1 px of its own."""
+    h, w = disp.shape
+    d = np.nan_to_num(disp, nan=-1e9)
+    pad = np.pad(d, 2, constant_values=-1e9)
+    count = np.zeros((h, w), np.int32)
+    for dy in range(5):
+        for dx in range(5):
+            if dy != 2 or dx != 2:
+                count += np.abs(pad[dy:dy + h, dx:dx + w] - d) <= 1.0
+    return count
 
 
 def apply_range(params: Any, rng: tuple[int, int]) -> Any:

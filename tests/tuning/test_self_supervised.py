@@ -50,6 +50,34 @@ def test_the_true_disparity_scores_better_than_wrong_ones(scene) -> None:
     assert terms_of_maps(scene.left, scene.right, holes, right_map(gt))["invalid"] >= 0.25
 
 
+def test_the_true_disparity_wins_under_an_exposure_change(scene) -> None:
+    gt = np.nan_to_num(scene.gt, nan=float(np.nanmin(scene.gt)))
+    darker = np.clip(scene.right.astype(np.float32) * 0.6 + 10, 0, 255).astype(np.uint8)
+    rng = np.random.default_rng(1)
+    noisy = gt + np.where(rng.random(gt.shape) < 0.2, rng.uniform(-6, 6, gt.shape), 0)
+    true = score_of(terms_of_maps(scene.left, darker, gt, right_map(gt)))
+    for wrong in (gt + 2, gt - 2, noisy):
+        assert score_of(terms_of_maps(scene.left, darker, wrong, right_map(wrong))) > true + 1
+
+
+def test_scattered_disparities_leave_holes_in_the_rebuilt_right_view(scene) -> None:
+    gt = np.nan_to_num(scene.gt, nan=float(np.nanmin(scene.gt)))
+    rng = np.random.default_rng(2)
+    noisy = gt + np.where(rng.random(gt.shape) < 0.2, rng.uniform(-6, 6, gt.shape), 0)
+    t_true = terms_of_maps(scene.left, scene.right, gt, right_map(gt))
+    t_noisy = terms_of_maps(scene.left, scene.right, noisy, right_map(gt))
+    assert t_true["holes"] < 0.05  # only where the left view is occluded
+    assert t_noisy["holes"] > t_true["holes"] + 0.05
+
+
+def test_a_map_with_no_disparity_pays_for_it(scene) -> None:
+    gt = np.nan_to_num(scene.gt, nan=float(np.nanmin(scene.gt)))
+    none = np.full_like(gt, np.nan)
+    t = terms_of_maps(scene.left, scene.right, none, none)
+    assert t["invalid"] == 1.0 and t["reconstruction"] == 0 and t["holes"] == 0
+    assert score_of(t) > score_of(terms_of_maps(scene.left, scene.right, gt, right_map(gt)))
+
+
 def test_reconstruction_is_robust_to_an_exposure_change(scene) -> None:
     gt = np.nan_to_num(scene.gt, nan=float(np.nanmin(scene.gt)))
     darker = np.clip(scene.right.astype(np.float32) * 0.6 + 10, 0, 255).astype(np.uint8)
