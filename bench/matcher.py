@@ -103,31 +103,36 @@ SGBM_3WAY = MatcherParams(matcher="opencv-sgbm", mode="sgbm3way", block_size=3,
                           uniqueness_ratio=10, speckle_window_size=100, speckle_range=2,
                           lr_check=1.0, fill=True, num_disparities=64)
 OWN_SGM = MatcherParams(matcher="sgm", block_size=1, lr_check=1.0, fill=True, border="clip",
-                        num_disparities=64)
+                        num_disparities=64)  # default paths (5)
 BEST_LOCAL = MatcherParams(matcher="ncc", block_size=5, border="clip", lr_check=1.0, fill=True,
                            median=5, num_disparities=64)
 
 
+SGM_PATHS = (5, 8, 4)  # the default first
+
+
 def sgm_vs_sgbm() -> None:
-    print("\n## own SGM (8 paths, LR 1 + fill) / cv2 SGBM 3WAY (block 3, LR 1 + fill), grey")
+    print("\n## own SGM (LR 1 + fill) / cv2 SGBM 3WAY (block 3, LR 1 + fill), grey")
     for name, gl, gr, nd in pairs()[:2]:
         for threads in (1, 2):
             set_threads(threads)
-            own = OWN_SGM.replace(num_disparities=nd)
-            ref = SGBM_3WAY.replace(num_disparities=nd, colour=False)
-            a, b = side_by_side(lambda: compute_disparity(gl, gr, own),  # noqa: B023
-                                lambda: compute_disparity(gl, gr, ref))  # noqa: B023
-            print(f"{name:<22} {gl.shape[1]}x{gl.shape[0]} nd {nd:<4} threads {threads}  "
-                  f"own {a:7.2f} ms  SGBM 3WAY {b:7.2f} ms  ratio {a / b:5.2f}  ({load()})",
-                  flush=True)
+            for paths in SGM_PATHS:
+                own = OWN_SGM.replace(num_disparities=nd, paths=paths)
+                ref = SGBM_3WAY.replace(num_disparities=nd, colour=False)
+                a, b = side_by_side(lambda: compute_disparity(gl, gr, own),  # noqa: B023
+                                    lambda: compute_disparity(gl, gr, ref))  # noqa: B023
+                print(f"{name:<22} {gl.shape[1]}x{gl.shape[0]} nd {nd:<4} threads {threads}  "
+                      f"paths {paths}  own {a:7.2f} ms  SGBM 3WAY {b:7.2f} ms  "
+                      f"ratio {a / b:5.2f}  ({load()})", flush=True)
 
 
 def quality(mb: Path) -> None:
     print("\n## quality, bad % at 1 px (density %), nonocc / all / disc")
-    rows = [("own SGM + LR 1 + fill", OWN_SGM),
-            ("SGBM 3WAY colour + LR 1 + fill", SGBM_3WAY),
-            ("SGBM 3WAY grey + LR 1 + fill", SGBM_3WAY.replace(colour=False)),
-            ("best local: ZNCC 5 + LR + fill + median 5", BEST_LOCAL)]
+    rows = [(f"own SGM {paths} paths + LR 1 + fill", OWN_SGM.replace(paths=paths))
+            for paths in SGM_PATHS]
+    rows += [("SGBM 3WAY colour + LR 1 + fill", SGBM_3WAY),
+             ("SGBM 3WAY grey + LR 1 + fill", SGBM_3WAY.replace(colour=False)),
+             ("best local: ZNCC 5 + LR + fill + median 5", BEST_LOCAL)]
     for scene_name in ("cones", "teddy"):
         s = load_scene(mb / scene_name)
         for label, p in rows:

@@ -102,6 +102,8 @@ def _sgm_sums(shape: tuple[int, ...], nd: int) -> np.ndarray:
     """The path-sum volume for SGM, reused by the next call on the same size in this thread:
     a fresh 39 MB costs several ms of page faults per call at 640x480 / 64."""
     key = (shape[0], shape[1], nd)
+    if not key[0]:
+        return np.empty(key, dtype=np.uint16)
     kept = getattr(_VOLUMES, "kept", None)
     if kept is not None and kept[0] == key:
         return kept[1]
@@ -125,8 +127,10 @@ def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
         vol = sgm.box_sum(sgm.hamming_volume(cl, cr, p.min_disparity, vol), p.block_size)
     p1, p2 = sgm_penalties(p)
     want_right = p.lr_check is not None
+    # the 5-path pass decides each row as it goes: no sum volume
+    sums = _sgm_sums(gl.shape if p.paths != 5 else (0, 0), p.num_disparities)
     disp_l, disp_r = sgm.match(cl, sgm.reversed_right(cr, p.min_disparity, p.num_disparities),
-                               vol, _sgm_sums(gl.shape, p.num_disparities), p.min_disparity,
+                               vol, sums, p.min_disparity,
                                np.uint16(p1), np.uint16(p2), p.paths,
                                float(p.uniqueness_ratio), subpixel_fit(p), want_right, False)
     if want_right:

@@ -10,7 +10,7 @@ from host.errors import HostError
 MATCHERS = ("sad", "ssd", "ncc", "sgm", "opencv-bm", "opencv-sgbm")
 BORDERS = ("invalid", "clip")
 SUBPIXEL_FITS = ("auto", "parabola", "equiangular")
-SGM_PATHS = (4, 8)
+SGM_PATHS = (4, 5, 8)
 SGBM_MODES = {"sgbm": 0, "hh": 1, "sgbm3way": 2, "hh4": 3}
 
 
@@ -25,7 +25,8 @@ class MatcherParams:
     (a pixel whose window leaves the image has no disparity) or "clip" (the window is cropped
     to the image; own matchers only); median = median-filter size
     applied after filling (0 = off); fill = fill invalid pixels from the farther valid neighbour;
-    paths = 8 or 4 aggregation paths of the own SGM (4: left, right, up, down).
+    paths = aggregation paths of the own SGM: 5 (left, right and the three from above, in one
+    pass; the default, within SGBM 3WAY's time), 8 or 4 (left, right, up, down).
     """
 
     matcher: str = "sad"
@@ -47,7 +48,7 @@ class MatcherParams:
     p1: int = 0
     p2: int = 0
     mode: str = "sgbm"
-    paths: int = 8
+    paths: int = 5
 
     def replace(self, **changes: Any) -> MatcherParams:
         return replace(self, **changes)
@@ -102,7 +103,7 @@ class MatcherParams:
             raise HostError(f"unknown SGBM mode {self.mode!r} "
                             f"(choose from {', '.join(SGBM_MODES)})")
         if self.paths not in SGM_PATHS:
-            raise HostError(f"paths must be 4 or 8 (own SGM), got {self.paths}")
+            raise HostError(f"paths must be 4, 5 or 8 (own SGM), got {self.paths}")
         if width is not None:
             if self.block_size >= width:
                 raise HostError(f"window {self.block_size} is too large for an image "

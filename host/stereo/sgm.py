@@ -174,30 +174,33 @@ def _first_min(s, idx, n):
 
 
 @njit(cache=True, fastmath=True)
-def _decide_row(tot, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc, idx, jj):
+def _decide_row(tot, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc, idx, jj, fb):
     """Left (and right) disparities of row y from its total path costs tot (cols, nd).
 
     The smallest candidate among equal costs wins. The right view's candidates are tot's
     diagonals (right pixel xr at candidate j is left pixel xr + dmin + j): each left pixel x
     lowers acc[cols - x + j] to its cost << 16 | j if that is smaller (the same candidate
     order, idx and jj = 0 .. nd in uint16 and uint32), so entry cols - dmin - xr ends as xr's
-    best; no uniqueness test on the right view.
+    best; no uniqueness test on the right view. The winners and their neighbours' costs go
+    into fb (4, cols) float32 first, so the sub-pixel fits run as one vector loop per row.
     """
     w, nd = tot.shape
     for x in range(w):
         s = tot[x]
         best, c0 = _first_min(s, idx, nd)
+        fb[0, x] = best
+        fb[2, x] = c0
+        inner = 0 < best < nd - 1
+        fb[1, x] = s[best - 1] if inner else c0  # no neighbours: a flat fit, offset 0
+        fb[3, x] = s[best + 1] if inner else c0
         if uniqueness > 0.0:
             bound = c0 * (1.0 + uniqueness / 100.0)
             close = 0
             for j in range(nd):
                 close += (j < best - 1 or j > best + 1) and s[j] <= bound
             if close:
-                continue
-        off = 0.0
-        if fit != FIT_NONE and 0 < best < nd - 1:
-            off = fit_offset(np.float32(s[best - 1]), c0, np.float32(s[best + 1]), fit)
-        disp_l[y, x] = dmin + best + off
+                fb[0, x] = np.nan
+    _fit_row(fb, disp_l[y], dmin, fit, w)
     if not want_right:
         return
     acc[:] = np.uint32(0xFFFFFFFF)
@@ -210,12 +213,25 @@ def _decide_row(tot, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc, 
         n = min(nd, w - xr - dmin)
         v = acc[w - dmin - xr]
         best = np.int64(v & np.uint32(0xFFFF))
-        off = 0.0
-        if fit != FIT_NONE and 0 < best < n - 1:
-            x = xr + dmin + best
-            off = fit_offset(np.float32(tot[x - 1, best - 1]), np.float32(v >> np.uint32(16)),
-                             np.float32(tot[x + 1, best + 1]), fit)
-        disp_r[y, xr] = dmin + best + off
+        c0 = np.float32(v >> np.uint32(16))
+        fb[0, xr] = best
+        fb[2, xr] = c0
+        x = xr + dmin + best
+        inner = 0 < best < n - 1
+        fb[1, xr] = tot[x - 1, best - 1] if inner else c0
+        fb[3, xr] = tot[x + 1, best + 1] if inner else c0
+    _fit_row(fb, disp_r[y], dmin, fit, w - dmin)
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _fit_row(fb, out, dmin, fit, n):
+    """out[:n] = dmin + winner + sub-pixel offset from fb (winner, cost before, at, after)."""
+    if fit == FIT_NONE:
+        for x in range(n):
+            out[x] = dmin + fb[0, x]
+    else:
+        for x in range(n):
+            out[x] = dmin + fb[0, x] + fit_offset(fb[1, x], fb[2, x], fb[3, x], fit)
 
 
 @njit(cache=True, fastmath=True)
@@ -235,6 +251,7 @@ def _sweep(cl, crrev, vol, S, P, M, crow, tot, forward, i0, i1, p1, p2, diagonal
     step = 1 if forward else -1
     idx = np.arange(nd + 1).astype(np.uint16)
     jj = np.arange(nd + 1).astype(np.uint32)
+    fb = np.empty((4, w), dtype=np.float32)
     for i in range(i0, i1):
         y = i if forward else h - 1 - i
         _cost_row(cl, crrev, vol, y, dmin, crow)
@@ -283,9 +300,75 @@ def _sweep(cl, crrev, vol, S, P, M, crow, tot, forward, i0, i1, p1, p2, diagonal
                 for j in range(nd):
                     o[j] = h0[j + 1] + v2[j + 1]
         if finish:
-            _decide_row(tot, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc, idx, jj)
+            _decide_row(tot, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc, idx, jj, fb)
             if keep:
                 S[y] = tot
+
+
+OVERLAP = 24  # rows the lower stripe of the 5-path pass starts above its first row
+
+
+@njit(cache=True, fastmath=True)
+def _down(cl, crrev, vol, S, P, M, crow, tot, y0, y1, warm, p1, p2, dmin, uniqueness, fit,
+          want_right, disp_l, disp_r, acc, keep):
+    """The 5-path pass over rows y0 .. y1 - 1, top to bottom: paths from the left, top-left,
+    top and top-right while x ascends, then the one from the right while x descends (into
+    path 0's slots, already summed), then the row is decided (with keep, its total stored in
+    S). The three paths from above start warm rows above y0 (those rows are not decided).
+    """
+    h, w = cl.shape
+    nd = crow.shape[1]
+    idx = np.arange(nd + 1).astype(np.uint16)
+    jj = np.arange(nd + 1).astype(np.uint32)
+    fb = np.empty((4, w), dtype=np.float32)
+    for i in range(y1 - y0 + warm):
+        y = y0 - warm + i
+        decided = i >= warm
+        _cost_row(cl, crrev, vol, y, dmin, crow)
+        b = i % 2
+        a = 1 - b
+        for x in range(w):
+            c = crow[x]
+            h0 = P[b, 0, x]
+            d1 = P[b, 1, x]
+            v2 = P[b, 2, x]
+            d3 = P[b, 3, x]
+            if i == 0 or x == 0:
+                M[b, 1, x] = _start(d1, c, nd)
+            else:
+                M[b, 1, x] = _step(P[a, 1, x - 1], M[a, 1, x - 1], d1, c, p1, p2, nd)
+            if i == 0:
+                M[b, 2, x] = _start(v2, c, nd)
+            else:
+                M[b, 2, x] = _step(P[a, 2, x], M[a, 2, x], v2, c, p1, p2, nd)
+            if i == 0 or x == w - 1:
+                M[b, 3, x] = _start(d3, c, nd)
+            else:
+                M[b, 3, x] = _step(P[a, 3, x + 1], M[a, 3, x + 1], d3, c, p1, p2, nd)
+            if not decided:
+                continue
+            if x == 0:
+                M[b, 0, x] = _start(h0, c, nd)
+            else:
+                M[b, 0, x] = _step(P[b, 0, x - 1], M[b, 0, x - 1], h0, c, p1, p2, nd)
+            o = tot[x]
+            for j in range(nd):
+                o[j] = h0[j + 1] + d1[j + 1] + v2[j + 1] + d3[j + 1]
+        if not decided:
+            continue
+        for x in range(w - 1, -1, -1):
+            c = crow[x]
+            h0 = P[b, 0, x]
+            if x == w - 1:
+                M[b, 0, x] = _start(h0, c, nd)
+            else:
+                M[b, 0, x] = _step(P[b, 0, x + 1], M[b, 0, x + 1], h0, c, p1, p2, nd)
+            o = tot[x]
+            for j in range(nd):
+                o[j] += h0[j + 1]
+        _decide_row(tot, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc, idx, jj, fb)
+        if keep:
+            S[y] = tot
 
 
 @njit(cache=True, parallel=True)
@@ -300,7 +383,11 @@ def match(cl, crrev, vol, S, dmin, p1, p2, paths, uniqueness, fit, want_right, k
     storing its sums; then each goes on into the other's half, adds its own paths to the
     stored sums and decides the row. So each half of S is written once and read once, every
     cost row is made where it is used, and with two threads the two directions run at once.
-    keep: leave the total path costs in S (for tests).
+    With 5 paths (left, right, top-left, top, top-right) one pass from the top decides each
+    row as it goes and S is not used: the image is cut into an upper and a lower stripe (one
+    per thread), and the lower stripe's paths from above start OVERLAP rows above it, the same
+    whatever the thread count, so results do not depend on it.
+    keep: leave the total path costs in S (rows, cols, nd; for tests).
     """
     h, w = cl.shape
     nd = S.shape[2]
@@ -314,6 +401,13 @@ def match(cl, crrev, vol, S, dmin, p1, p2, paths, uniqueness, fit, want_right, k
     disp_l = np.full((h, w), np.nan, dtype=np.float32)
     disp_r = np.full((h, w), np.nan, dtype=np.float32)
     upper = (h + 1) // 2
+    if paths == 5:
+        for k in prange(2):
+            y0, y1 = (0, upper) if k == 0 else (upper, h)
+            _down(cl, crrev, vol, S, P[k], M[k], crow[k], tot[k], y0, y1,
+                  0 if k == 0 else min(OVERLAP, upper), p1, p2, dmin, uniqueness, fit,
+                  want_right, disp_l, disp_r, acc[k], keep)
+        return disp_l, disp_r
     diagonals = paths == 8
     for phase in range(2):
         for k in prange(2):
