@@ -241,7 +241,7 @@ def _sweep(cl, crrev, vol, S, P, M, crow, tot, forward, i0, i1, p1, p2, diagonal
     direction's paths: path 0 from behind in the row, 2 from the row before at the same x,
     and (diagonals) 1 and 3 from the row before at x - step and x + step.
 
-    P (2 row parities, 4 paths, cols, nd + 2) and M (2, 4, cols) carry the path costs from
+    P (2 row parities, 5 path slots, cols, nd + 2) and M (2, 5, cols) carry the path costs from
     row to row, so one direction can stop at a row and go on from it in a later call. Without
     finish the row's path sum goes into S; with finish it is added to S's row (the other
     direction's sum) into tot and decided (and, with keep, stored back into S).
@@ -311,10 +311,10 @@ OVERLAP = 24  # rows the lower stripe of the 5-path pass starts above its first 
 @njit(cache=True, fastmath=True)
 def _down(cl, crrev, vol, S, P, M, crow, tot, y0, y1, warm, p1, p2, dmin, uniqueness, fit,
           want_right, disp_l, disp_r, acc, keep):
-    """The 5-path pass over rows y0 .. y1 - 1, top to bottom: paths from the left, top-left,
-    top and top-right while x ascends, then the one from the right while x descends (into
-    path 0's slots, already summed), then the row is decided (with keep, its total stored in
-    S). The three paths from above start warm rows above y0 (those rows are not decided).
+    """The 5-path pass over rows y0 .. y1 - 1, top to bottom: paths 1-3 from the top-left,
+    top and top-right and 0 from the left at x = t, 4 from the right at x = w - 1 - t, then
+    the row's sum is decided (with keep, stored in S). The three paths from above start warm
+    rows above y0 (those rows are not decided).
     """
     h, w = cl.shape
     nd = crow.shape[1]
@@ -327,45 +327,46 @@ def _down(cl, crrev, vol, S, P, M, crow, tot, y0, y1, warm, p1, p2, dmin, unique
         _cost_row(cl, crrev, vol, y, dmin, crow)
         b = i % 2
         a = 1 - b
-        for x in range(w):
+        for t in range(w):
+            x = t
             c = crow[x]
+            if i == 0 or x == 0:
+                M[b, 1, x] = _start(P[b, 1, x], c, nd)
+            else:
+                M[b, 1, x] = _step(P[a, 1, x - 1], M[a, 1, x - 1], P[b, 1, x], c, p1, p2, nd)
+            if i == 0:
+                M[b, 2, x] = _start(P[b, 2, x], c, nd)
+            else:
+                M[b, 2, x] = _step(P[a, 2, x], M[a, 2, x], P[b, 2, x], c, p1, p2, nd)
+            if i == 0 or x == w - 1:
+                M[b, 3, x] = _start(P[b, 3, x], c, nd)
+            else:
+                M[b, 3, x] = _step(P[a, 3, x + 1], M[a, 3, x + 1], P[b, 3, x], c, p1, p2, nd)
+            if not decided:
+                continue
+            # the two paths along the row are chains (each step waits for the one before):
+            # stepping both here lets the processor overlap them with the three above
+            if x == 0:
+                M[b, 0, x] = _start(P[b, 0, x], c, nd)
+            else:
+                M[b, 0, x] = _step(P[b, 0, x - 1], M[b, 0, x - 1], P[b, 0, x], c, p1, p2, nd)
+            x = w - 1 - t
+            c = crow[x]
+            if x == w - 1:
+                M[b, 4, x] = _start(P[b, 4, x], c, nd)
+            else:
+                M[b, 4, x] = _step(P[b, 4, x + 1], M[b, 4, x + 1], P[b, 4, x], c, p1, p2, nd)
+        if not decided:
+            continue
+        for x in range(w):
+            o = tot[x]
             h0 = P[b, 0, x]
             d1 = P[b, 1, x]
             v2 = P[b, 2, x]
             d3 = P[b, 3, x]
-            if i == 0 or x == 0:
-                M[b, 1, x] = _start(d1, c, nd)
-            else:
-                M[b, 1, x] = _step(P[a, 1, x - 1], M[a, 1, x - 1], d1, c, p1, p2, nd)
-            if i == 0:
-                M[b, 2, x] = _start(v2, c, nd)
-            else:
-                M[b, 2, x] = _step(P[a, 2, x], M[a, 2, x], v2, c, p1, p2, nd)
-            if i == 0 or x == w - 1:
-                M[b, 3, x] = _start(d3, c, nd)
-            else:
-                M[b, 3, x] = _step(P[a, 3, x + 1], M[a, 3, x + 1], d3, c, p1, p2, nd)
-            if not decided:
-                continue
-            if x == 0:
-                M[b, 0, x] = _start(h0, c, nd)
-            else:
-                M[b, 0, x] = _step(P[b, 0, x - 1], M[b, 0, x - 1], h0, c, p1, p2, nd)
-            o = tot[x]
+            h4 = P[b, 4, x]
             for j in range(nd):
-                o[j] = h0[j + 1] + d1[j + 1] + v2[j + 1] + d3[j + 1]
-        if not decided:
-            continue
-        for x in range(w - 1, -1, -1):
-            c = crow[x]
-            h0 = P[b, 0, x]
-            if x == w - 1:
-                M[b, 0, x] = _start(h0, c, nd)
-            else:
-                M[b, 0, x] = _step(P[b, 0, x + 1], M[b, 0, x + 1], h0, c, p1, p2, nd)
-            o = tot[x]
-            for j in range(nd):
-                o[j] += h0[j + 1]
+                o[j] = h0[j + 1] + d1[j + 1] + v2[j + 1] + d3[j + 1] + h4[j + 1]
         _decide_row(tot, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc, idx, jj, fb)
         if keep:
             S[y] = tot
@@ -391,10 +392,10 @@ def match(cl, crrev, vol, S, dmin, p1, p2, paths, uniqueness, fit, want_right, k
     """
     h, w = cl.shape
     nd = S.shape[2]
-    P = np.empty((2, 2, 4, w, nd + 2), dtype=np.uint16)
+    P = np.empty((2, 2, 5, w, nd + 2), dtype=np.uint16)
     P[:, :, :, :, 0] = PAD
     P[:, :, :, :, nd + 1] = PAD
-    M = np.zeros((2, 2, 4, w), dtype=np.uint16)
+    M = np.zeros((2, 2, 5, w), dtype=np.uint16)
     crow = np.empty((2, w, nd), dtype=np.uint16)
     tot = np.empty((2, w, nd), dtype=np.uint16)
     acc = np.empty((2, w + nd), dtype=np.uint32)
