@@ -37,22 +37,31 @@ def census(img):
     """9x7 census of a uint8 image: bit set where a neighbour is darker than the centre.
 
     img is padded by the caller (CENSUS_H rows, CENSUS_W columns, replicated border), so the
-    loop over x has no clamping and runs in vector lanes.
+    loop over x has no clamping and runs in vector lanes. The first 31 neighbours' bits and the
+    last 31 are gathered in two uint32 rows (twice the lanes of uint64), then joined.
     """
     hp, wp = img.shape
     h, w = hp - 2 * CENSUS_H, wp - 2 * CENSUS_W
-    out = np.zeros((h, w), dtype=np.uint64)
+    half = CENSUS_BITS // 2
+    out = np.empty((h, w), dtype=np.uint64)
     for y in prange(h):
-        row = out[y]
+        hi = np.zeros(w, dtype=np.uint32)
+        lo = np.zeros(w, dtype=np.uint32)
         centre = img[y + CENSUS_H, CENSUS_W:CENSUS_W + w]
+        k = 0
         for dy in range(2 * CENSUS_H + 1):
             nb_row = img[y + dy]
             for dx in range(2 * CENSUS_W + 1):
                 if dy == CENSUS_H and dx == CENSUS_W:
                     continue
                 nb = nb_row[dx:dx + w]
+                acc = hi if k < half else lo
                 for x in range(w):
-                    row[x] = (row[x] << np.uint64(1)) | np.uint64(nb[x] < centre[x])
+                    acc[x] = (acc[x] << np.uint32(1)) | np.uint32(nb[x] < centre[x])
+                k += 1
+        row = out[y]
+        for x in range(w):
+            row[x] = (np.uint64(hi[x]) << np.uint64(CENSUS_BITS - half)) | np.uint64(lo[x])
     return out
 
 
