@@ -190,8 +190,10 @@ def _decide_row(tot, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc, 
     diagonals (right pixel xr at candidate j is left pixel xr + dmin + j): each left pixel x
     lowers acc[cols - x + j] to its cost << 16 | j if that is smaller (the same candidate
     order, idx and jj = 0 .. nd in uint16 and uint32), so entry cols - dmin - xr ends as xr's
-    best; no uniqueness test on the right view. The winners and their neighbours' costs go
-    into fb (4, cols) float32 first, so the sub-pixel fits run as one vector loop per row.
+    best; the right view gets whole pixels (the LR check compares within a pixel; its
+    sub-pixel fit cost time and changed Cones and Teddy by under 0.1 %) and no uniqueness test.
+    The left winners and their neighbours' costs go into fb (4, cols) float32 first, so the
+    sub-pixel fits run as one vector loop per row.
     """
     w, nd = tot.shape
     for x in range(w):
@@ -218,18 +220,9 @@ def _decide_row(tot, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc, 
         a = acc[w - x:w - x + nd]
         for j in range(nd):
             a[j] = min(a[j], np.uint32((np.uint32(s[j]) << np.uint32(16)) | jj[j]))
+    row = disp_r[y]
     for xr in range(w - dmin):
-        n = min(nd, w - xr - dmin)
-        v = acc[w - dmin - xr]
-        best = np.int64(v & np.uint32(0xFFFF))
-        c0 = np.float32(v >> np.uint32(16))
-        fb[0, xr] = best
-        fb[2, xr] = c0
-        x = xr + dmin + best
-        inner = 0 < best < n - 1
-        fb[1, xr] = tot[x - 1, best - 1] if inner else c0
-        fb[3, xr] = tot[x + 1, best + 1] if inner else c0
-    _fit_row(fb, disp_r[y], dmin, fit, w - dmin)
+        row[xr] = dmin + (acc[w - dmin - xr] & np.uint32(0xFFFF))
 
 
 @njit(cache=True, fastmath=True, inline="always")
