@@ -121,15 +121,16 @@ def test_sgm_gives_the_same_map_on_one_and_two_threads(paths: int) -> None:
     np.testing.assert_array_equal(maps[0], maps[1])
 
 
+@pytest.mark.parametrize("p2", [12, 3000])  # totals in 13 bits (uint16 packing) or not
 @pytest.mark.parametrize("paths", [8, 5, 4])
-def test_both_maps_are_the_first_minimum_of_the_total_along_rows_and_diagonals(paths) -> None:
+def test_both_maps_are_the_first_minimum_of_the_total_along_rows_and_diagonals(paths, p2) -> None:
     # the right map comes from the same summed costs as the left one: right pixel xr at
     # disparity d is left pixel xr + d (no second, right-referenced aggregation)
     rng = np.random.default_rng(8)
     cost = rng.integers(0, 20, (7, 30, 6)).astype(np.uint16)
     dmin = 2
-    left, right, _ = _match(cost, 3, 12, paths, dmin=dmin)
-    total = _naive_paths(cost, 3, 12, {8: EIGHT, 5: FIVE, 4: FOUR}[paths])
+    left, right, _ = _match(cost, 3, p2, paths, dmin=dmin)
+    total = _naive_paths(cost, 3, p2, {8: EIGHT, 5: FIVE, 4: FOUR}[paths])
     h, w, nd = cost.shape
     for y in range(h):
         for x in range(w):
