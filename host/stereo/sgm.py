@@ -169,12 +169,9 @@ def _start(dst, c, nd):
 
 
 @njit(cache=True, fastmath=True, inline="always")
-def _first_min(s, idx, n):
-    """(smallest j with s[j] minimal over s[:n], that minimum), both in s's dtype: two
-    vectorised min reductions (idx = 0 .. len(s) in s's dtype, its last entry the largest)."""
-    m = s[0]
-    for j in range(n):
-        m = min(m, s[j])
+def _first_min(s, m, idx, n):
+    """(smallest j with s[j] == m, the minimum of s[:n], found as the row was summed; m): a
+    vectorised min reduction (idx = 0 .. len(s) in s's dtype, its last entry the largest)."""
     big = idx[idx.size - 1]
     best = big
     for j in range(n):
@@ -183,9 +180,10 @@ def _first_min(s, idx, n):
 
 
 @njit(cache=True, fastmath=True)
-def _decide_row(tot, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc, acc16, sh, idx,
-                jj, fb):
-    """Left (and right) disparities of row y from its total path costs tot (cols, nd).
+def _decide_row(tot, mins, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc, acc16,
+                sh, idx, jj, fb):
+    """Left (and right) disparities of row y from its total path costs tot (cols, nd) and
+    their minima per pixel, mins.
 
     The smallest candidate among equal costs wins. The right view's candidates are tot's
     diagonals (right pixel xr at candidate j is left pixel xr + dmin + j): each left pixel x
@@ -201,7 +199,7 @@ def _decide_row(tot, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc, 
     w, nd = tot.shape
     for x in range(w):
         s = tot[x]
-        best, c0 = _first_min(s, idx, nd)
+        best, c0 = _first_min(s, mins[x], idx, nd)
         fb[0, x] = best
         fb[2, x] = c0
         inner = 0 < best < nd - 1
@@ -268,6 +266,7 @@ def _sweep(cl, crrev, vol, S, P, M, crow, tot, forward, i0, i1, p1, p2, diagonal
     idx = np.arange(nd + 1).astype(np.uint16)
     jj = np.arange(nd + 1).astype(np.uint32)
     fb = np.empty((4, w), dtype=np.float32)
+    mins = np.empty(w, dtype=np.uint16)
     for i in range(i0, i1):
         y = i if forward else h - 1 - i
         _cost_row(cl, crrev, vol, y, dmin, crow)
@@ -300,8 +299,12 @@ def _sweep(cl, crrev, vol, S, P, M, crow, tot, forward, i0, i1, p1, p2, diagonal
                 if finish:
                     o = tot[x]
                     s = S[y, x]
+                    lo = np.uint16(0xFFFF)
                     for j in range(nd):
-                        o[j] = s[j] + h0[j + 1] + d1[j + 1] + v2[j + 1] + d3[j + 1]
+                        v = np.uint16(s[j] + h0[j + 1] + d1[j + 1] + v2[j + 1] + d3[j + 1])
+                        o[j] = v
+                        lo = min(lo, v)
+                    mins[x] = lo
                 else:
                     o = S[y, x]
                     for j in range(nd):
@@ -309,15 +312,19 @@ def _sweep(cl, crrev, vol, S, P, M, crow, tot, forward, i0, i1, p1, p2, diagonal
             elif finish:
                 o = tot[x]
                 s = S[y, x]
+                lo = np.uint16(0xFFFF)
                 for j in range(nd):
-                    o[j] = s[j] + h0[j + 1] + v2[j + 1]
+                    v = np.uint16(s[j] + h0[j + 1] + v2[j + 1])
+                    o[j] = v
+                    lo = min(lo, v)
+                mins[x] = lo
             else:
                 o = S[y, x]
                 for j in range(nd):
                     o[j] = h0[j + 1] + v2[j + 1]
         if finish:
-            _decide_row(tot, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc, acc16, sh,
-                        idx, jj, fb)
+            _decide_row(tot, mins, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc,
+                        acc16, sh, idx, jj, fb)
             if keep:
                 S[y] = tot
 
@@ -338,6 +345,7 @@ def _down(cl, crrev, vol, S, P, M, crow, tot, y0, y1, warm, p1, p2, dmin, unique
     idx = np.arange(nd + 1).astype(np.uint16)
     jj = np.arange(nd + 1).astype(np.uint32)
     fb = np.empty((4, w), dtype=np.float32)
+    mins = np.empty(w, dtype=np.uint16)
     for i in range(y1 - y0 + warm):
         y = y0 - warm + i
         decided = i >= warm
@@ -382,10 +390,14 @@ def _down(cl, crrev, vol, S, P, M, crow, tot, y0, y1, warm, p1, p2, dmin, unique
             v2 = P[b, 2, x]
             d3 = P[b, 3, x]
             h4 = P[b, 4, x]
+            lo = np.uint16(0xFFFF)
             for j in range(nd):
-                o[j] = h0[j + 1] + d1[j + 1] + v2[j + 1] + d3[j + 1] + h4[j + 1]
-        _decide_row(tot, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc, acc16, sh,
-                        idx, jj, fb)
+                v = np.uint16(h0[j + 1] + d1[j + 1] + v2[j + 1] + d3[j + 1] + h4[j + 1])
+                o[j] = v
+                lo = min(lo, v)
+            mins[x] = lo
+        _decide_row(tot, mins, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc,
+                        acc16, sh, idx, jj, fb)
         if keep:
             S[y] = tot
 
