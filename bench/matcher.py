@@ -5,8 +5,9 @@ alternating (own, OpenCV, own, ...) in one process, both on the same grey input 
 window and disparity range; a time is the median over blocks of the mean call time in a block,
 and the figure that matters is the ratio own / OpenCV. Thread counts are set for both sides
 (numba.set_num_threads, cv2.setNumThreads); the machine's load (`uptime`) is printed beside
-every figure, since other work on the machine moves absolute times. Then quality on Cones and
-Teddy (Middlebury v2 metric, rho 1 px) and the sub-pixel fits compared.
+every figure, since other work on the machine moves absolute times. The SGM rows on one
+thread also give the ratio of process CPU time, which other work moves much less. Then
+quality on Cones and Teddy (Middlebury v2 metric, rho 1 px) and the sub-pixel fits compared.
 """
 
 from __future__ import annotations
@@ -56,6 +57,30 @@ def side_by_side(own, ref) -> tuple[float, float]:
     return statistics.median(a), statistics.median(b)
 
 
+def _cpu_block(fn, calls: int) -> tuple[float, float]:
+    w0, c0 = time.perf_counter(), time.process_time()
+    for _ in range(calls):
+        fn()
+    return ((time.perf_counter() - w0) * 1000 / calls, (time.process_time() - c0) * 1000 / calls)
+
+
+def side_by_side_cpu(own, ref) -> tuple[float, float, float, float]:
+    """Like side_by_side, also with the process CPU time per call: (wall own, wall ref, CPU
+    own, CPU ref), medians over blocks. On one thread the CPU time is what the call would take
+    on an idle core, so its ratio holds up when other work shares the machine."""
+    own()
+    ref()
+    t0 = time.perf_counter()
+    ref()
+    calls = max(2, int(CALL_MS / max(1.0, (time.perf_counter() - t0) * 1000)))
+    a, b = [], []
+    for _ in range(BLOCKS):
+        a.append(_cpu_block(own, calls))
+        b.append(_cpu_block(ref, calls))
+    med = [statistics.median(v[k] for v in x) for k in (0, 1) for x in (a, b)]
+    return med[0], med[1], med[2], med[3]
+
+
 def set_threads(n: int) -> None:
     numba.set_num_threads(n)
     cv2.setNumThreads(n)
@@ -103,31 +128,38 @@ SGBM_3WAY = MatcherParams(matcher="opencv-sgbm", mode="sgbm3way", block_size=3,
                           uniqueness_ratio=10, speckle_window_size=100, speckle_range=2,
                           lr_check=1.0, fill=True, num_disparities=64)
 OWN_SGM = MatcherParams(matcher="sgm", block_size=1, lr_check=1.0, fill=True, border="clip",
-                        num_disparities=64)
+                        num_disparities=64)  # default paths (5)
 BEST_LOCAL = MatcherParams(matcher="ncc", block_size=5, border="clip", lr_check=1.0, fill=True,
                            median=5, num_disparities=64)
 
 
+SGM_PATHS = (5, 8, 4)  # the default first
+
+
 def sgm_vs_sgbm() -> None:
-    print("\n## own SGM (8 paths, LR 1 + fill) / cv2 SGBM 3WAY (block 3, LR 1 + fill), grey")
+    print("\n## own SGM (LR 1 + fill) / cv2 SGBM 3WAY (block 3, LR 1 + fill), grey")
     for name, gl, gr, nd in pairs()[:2]:
         for threads in (1, 2):
             set_threads(threads)
-            own = OWN_SGM.replace(num_disparities=nd)
-            ref = SGBM_3WAY.replace(num_disparities=nd, colour=False)
-            a, b = side_by_side(lambda: compute_disparity(gl, gr, own),  # noqa: B023
-                                lambda: compute_disparity(gl, gr, ref))  # noqa: B023
-            print(f"{name:<22} {gl.shape[1]}x{gl.shape[0]} nd {nd:<4} threads {threads}  "
-                  f"own {a:7.2f} ms  SGBM 3WAY {b:7.2f} ms  ratio {a / b:5.2f}  ({load()})",
-                  flush=True)
+            for paths in SGM_PATHS:
+                own = OWN_SGM.replace(num_disparities=nd, paths=paths)
+                ref = SGBM_3WAY.replace(num_disparities=nd, colour=False)
+                a, b, ca, cb = side_by_side_cpu(
+                    lambda: compute_disparity(gl, gr, own),  # noqa: B023
+                    lambda: compute_disparity(gl, gr, ref))  # noqa: B023
+                cpu = f"  CPU {ca:6.1f} / {cb:6.1f} ms ratio {ca / cb:5.2f}" if threads == 1 else ""
+                print(f"{name:<22} {gl.shape[1]}x{gl.shape[0]} nd {nd:<4} threads {threads}  "
+                      f"paths {paths}  own {a:7.2f} ms  SGBM 3WAY {b:7.2f} ms  "
+                      f"ratio {a / b:5.2f}{cpu}  ({load()})", flush=True)
 
 
 def quality(mb: Path) -> None:
     print("\n## quality, bad % at 1 px (density %), nonocc / all / disc")
-    rows = [("own SGM + LR 1 + fill", OWN_SGM),
-            ("SGBM 3WAY colour + LR 1 + fill", SGBM_3WAY),
-            ("SGBM 3WAY grey + LR 1 + fill", SGBM_3WAY.replace(colour=False)),
-            ("best local: ZNCC 5 + LR + fill + median 5", BEST_LOCAL)]
+    rows = [(f"own SGM {paths} paths + LR 1 + fill", OWN_SGM.replace(paths=paths))
+            for paths in SGM_PATHS]
+    rows += [("SGBM 3WAY colour + LR 1 + fill", SGBM_3WAY),
+             ("SGBM 3WAY grey + LR 1 + fill", SGBM_3WAY.replace(colour=False)),
+             ("best local: ZNCC 5 + LR + fill + median 5", BEST_LOCAL)]
     for scene_name in ("cones", "teddy"):
         s = load_scene(mb / scene_name)
         for label, p in rows:

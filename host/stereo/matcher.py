@@ -114,36 +114,44 @@ def sgm_penalties(p: MatcherParams) -> tuple[int, int]:
 
 
 _VOLUMES = threading.local()
-KEEP_BYTES = 256 << 20  # volumes up to this size are kept for the next call of the same size
+KEEP_BYTES = 128 << 20  # sum volumes up to this size are kept for the next call of the same size
 
 
-def _sgm_volumes(shape: tuple[int, ...], nd: int) -> tuple[np.ndarray, np.ndarray]:
-    """Cost and sum volumes for SGM, reused by the next call on the same size in this thread:
-    a fresh 100 MB costs ~15 ms of page faults per call at 640x480 / 64."""
+def _sgm_sums(shape: tuple[int, ...], nd: int) -> np.ndarray:
+    """The path-sum volume for SGM, reused by the next call on the same size in this thread:
+    a fresh 39 MB costs several ms of page faults per call at 640x480 / 64."""
     key = (shape[0], shape[1], nd)
+    if not key[0]:
+        return np.empty(key, dtype=np.uint16)
     kept = getattr(_VOLUMES, "kept", None)
     if kept is not None and kept[0] == key:
-        return kept[1], kept[2]
-    cost = np.empty(key, dtype=np.uint16)
-    sums = np.empty((2, *key), dtype=np.uint16)
-    _VOLUMES.kept = (key, cost, sums) if 3 * cost.nbytes <= KEEP_BYTES else None
-    return cost, sums
+        return kept[1]
+    sums = np.empty(key, dtype=np.uint16)
+    _VOLUMES.kept = (key, sums) if sums.nbytes <= KEEP_BYTES else None
+    return sums
+
+
+NO_VOLUME = np.empty((0, 0, 0), dtype=np.uint16)
 
 
 def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.ndarray:
     """The own census + semi-global matcher (host/stereo/sgm.py) on grey."""
     gl, gr = to_grey(left), to_grey(right)
-    census = [sgm.census(cv2.copyMakeBorder(g, sgm.CENSUS_H, sgm.CENSUS_H, sgm.CENSUS_W,
-                                            sgm.CENSUS_W, cv2.BORDER_REPLICATE)) for g in (gl, gr)]
-    cost, sums = _sgm_volumes(gl.shape, p.num_disparities)
-    sgm.hamming_volume(census[0], census[1], p.min_disparity, cost)
+    cl, cr = [sgm.census(cv2.copyMakeBorder(g, sgm.CENSUS_H, sgm.CENSUS_H, sgm.CENSUS_W,
+                                            sgm.CENSUS_W, cv2.BORDER_REPLICATE))
+              for g in (gl, gr)]
+    vol = NO_VOLUME
     if p.block_size > 1:
-        cost = sgm.box_sum(cost, p.block_size)
+        vol = np.empty((*gl.shape, p.num_disparities), dtype=np.uint16)
+        vol = sgm.box_sum(sgm.hamming_volume(cl, cr, p.min_disparity, vol), p.block_size)
     p1, p2 = sgm_penalties(p)
-    sgm.aggregate(cost, sums, np.uint16(p1), np.uint16(p2))
     want_right = p.lr_check is not None
-    disp_l, disp_r = sgm.decide(sums, p.min_disparity, float(p.uniqueness_ratio),
-                                subpixel_fit(p), want_right)
+    # the 5-path pass decides each row as it goes: no sum volume
+    sums = _sgm_sums(gl.shape if p.paths != 5 else (0, 0), p.num_disparities)
+    disp_l, disp_r = sgm.match(cl, sgm.reversed_right(cr, p.min_disparity, p.num_disparities),
+                               vol, sums, p.min_disparity,
+                               np.uint16(p1), np.uint16(p2), p.paths,
+                               float(p.uniqueness_ratio), subpixel_fit(p), want_right, False)
     if want_right:
         disp_l = lr_consistency(disp_l, disp_r, float(p.lr_check))
     if p.border == "invalid":

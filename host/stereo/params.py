@@ -10,6 +10,7 @@ from host.errors import HostError
 MATCHERS = ("sad", "ssd", "ncc", "sgm", "opencv-bm", "opencv-sgbm")
 BORDERS = ("invalid", "clip")
 SUBPIXEL_FITS = ("auto", "parabola", "equiangular")
+SGM_PATHS = (4, 5, 8)
 SGBM_MODES = {"sgbm": 0, "hh": 1, "sgbm3way": 2, "hh4": 3}
 
 
@@ -23,7 +24,9 @@ class MatcherParams:
     channels where the input has them (SAD, SSD, SGBM), else on grey; border = "invalid"
     (a pixel whose window leaves the image has no disparity) or "clip" (the window is cropped
     to the image; own matchers only); median = median-filter size
-    applied after filling (0 = off); fill = fill invalid pixels from the farther valid neighbour.
+    applied after filling (0 = off); fill = fill invalid pixels from the farther valid neighbour;
+    paths = aggregation paths of the own SGM: 5 (left, right and the three from above, in one
+    pass; the default, within SGBM 3WAY's time), 8 or 4 (left, right, up, down).
     """
 
     matcher: str = "sad"
@@ -45,6 +48,7 @@ class MatcherParams:
     p1: int = 0
     p2: int = 0
     mode: str = "sgbm"
+    paths: int = 5
 
     def replace(self, **changes: Any) -> MatcherParams:
         return replace(self, **changes)
@@ -98,6 +102,8 @@ class MatcherParams:
         if self.mode not in SGBM_MODES:
             raise HostError(f"unknown SGBM mode {self.mode!r} "
                             f"(choose from {', '.join(SGBM_MODES)})")
+        if self.paths not in SGM_PATHS:
+            raise HostError(f"paths must be 4, 5 or 8 (own SGM), got {self.paths}")
         if width is not None:
             if self.block_size >= width:
                 raise HostError(f"window {self.block_size} is too large for an image "

@@ -37,22 +37,31 @@ def census(img):
     """9x7 census of a uint8 image: bit set where a neighbour is darker than the centre.
 
     img is padded by the caller (CENSUS_H rows, CENSUS_W columns, replicated border), so the
-    loop over x has no clamping and runs in vector lanes.
+    loop over x has no clamping and runs in vector lanes. The first 31 neighbours' bits and the
+    last 31 are gathered in two uint32 rows (twice the lanes of uint64), then joined.
     """
     hp, wp = img.shape
     h, w = hp - 2 * CENSUS_H, wp - 2 * CENSUS_W
-    out = np.zeros((h, w), dtype=np.uint64)
+    half = CENSUS_BITS // 2
+    out = np.empty((h, w), dtype=np.uint64)
     for y in prange(h):
-        row = out[y]
+        hi = np.zeros(w, dtype=np.uint32)
+        lo = np.zeros(w, dtype=np.uint32)
         centre = img[y + CENSUS_H, CENSUS_W:CENSUS_W + w]
+        k = 0
         for dy in range(2 * CENSUS_H + 1):
             nb_row = img[y + dy]
             for dx in range(2 * CENSUS_W + 1):
                 if dy == CENSUS_H and dx == CENSUS_W:
                     continue
                 nb = nb_row[dx:dx + w]
+                acc = hi if k < half else lo
                 for x in range(w):
-                    row[x] = (row[x] << np.uint64(1)) | np.uint64(nb[x] < centre[x])
+                    acc[x] = (acc[x] << np.uint32(1)) | np.uint32(nb[x] < centre[x])
+                k += 1
+        row = out[y]
+        for x in range(w):
+            row[x] = (np.uint64(hi[x]) << np.uint64(CENSUS_BITS - half)) | np.uint64(lo[x])
     return out
 
 
@@ -102,120 +111,359 @@ def box_sum(raw, box):
     return out
 
 
+PAD = np.uint16(0x3FFF)  # path cost beyond the disparity range: never the minimum
+
+
 @njit(cache=True, fastmath=True, inline="always")
-def _path_step(buf, mins, src, dst, cost, y, x, p1, p2, nd):
-    """One step of a path into slot dst from slot src of buf (a slot holds one path's costs,
-    padded by a large value at each end; mins[slot] is its minimum):
+def _cost_row(cl, crrev, vol, y, dmin, crow):
+    """Row y of the cost into crow (cols, nd): vol's row when a volume is given (box-summed
+    cost), else the census Hamming distances straight from the census images.
+
+    crrev holds each right census row reversed and zero-padded, so candidate j of left x reads
+    it forwards from w - 1 - x + dmin: a contiguous load, one vector popcount per 8 lanes (the
+    loop over views vectorises; the same loop over 2-D indices does not).
+    """
+    w = cl.shape[1]
+    nd = crow.shape[1]
+    if vol.shape[0] > 0:
+        crow[:, :] = vol[y]
+        return
+    far = np.uint16(CENSUS_BITS)
+    for x in range(w):
+        a = cl[y, x]
+        base = w - 1 - x + dmin
+        r = crrev[y, base:base + nd]
+        c = crow[x]
+        for j in range(nd):
+            c[j] = np.uint16(_popcount(a ^ r[j]))
+        for j in range(max(0, x - dmin + 1), nd):
+            c[j] = far
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _step(src, m, dst, c, p1, p2, nd):
+    """One step of a path: dst[1:nd + 1] = L from the previous L' = src[1:nd + 1] (both padded
+    by PAD at each end; m = min L') and the cost c; returns min L.
     L[j] = C[j] + min(L'[j], L'[j-1] + P1, L'[j+1] + P1, min L' + P2) - min L'.
 
-    Indices, not views (a view costs two atomic reference counts); every intermediate is cast
-    back to uint16 so the loop runs in 16-bit lanes. One output per loop: more would alias.
+    Every intermediate is cast back to uint16 so the loop runs in 16-bit lanes.
     """
-    m = mins[src]
     jump = np.uint16(m + p2)
     lo = np.uint16(0xFFFF)
     for j in range(nd):
-        near = np.uint16(min(buf[src, j], buf[src, j + 2]) + p1)
-        v = np.uint16(cost[y, x, j] + min(buf[src, j + 1], near, jump) - m)
-        buf[dst, j + 1] = v
+        near = np.uint16(min(src[j], src[j + 2]) + p1)
+        v = np.uint16(c[j] + min(src[j + 1], near, jump) - m)
+        dst[j + 1] = v
         lo = min(lo, v)
-    mins[dst] = lo
-
-
-@njit(cache=True, fastmath=True)
-def _pass(cost, total, forward, p1, p2):
-    """Aggregate the 4 paths entering from one side into total (rows, cols, nd).
-
-    buf slots: 0 all zero (a path starting there: its step gives L = C), 1-2 the horizontal
-    path (previous and current pixel), then for each of the two row parities and each of the
-    3 paths from the row above (from x + step, x, x - step), one slot per column.
-    """
-    h, w, nd = cost.shape
-    buf = np.full((3 + 6 * w, nd + 2), np.uint16(0x3FFF), dtype=np.uint16)
-    buf[0, 1:nd + 1] = 0
-    mins = np.zeros(3 + 6 * w, dtype=np.uint16)
-    step = 1 if forward else -1
-    for i in range(h):
-        y = i if forward else h - 1 - i
-        cur0 = 3 + (i % 2) * 3 * w
-        prev0 = 3 + ((i + 1) % 2) * 3 * w
-        for t in range(w):
-            x = t if forward else w - 1 - t
-            hd = 1 + (t + 1) % 2
-            _path_step(buf, mins, 0 if t == 0 else 1 + t % 2, hd, cost, y, x, p1, p2, nd)
-            for j in range(nd):
-                total[y, x, j] = buf[hd, j + 1]
-            for r in range(3):
-                xs = x + step * (1 - r)  # r = 0, 1, 2: from x + step, x, x - step above
-                dst = cur0 + r * w + x
-                src = prev0 + r * w + xs if i > 0 and 0 <= xs < w else 0
-                _path_step(buf, mins, src, dst, cost, y, x, p1, p2, nd)
-                for j in range(nd):
-                    total[y, x, j] += buf[dst, j + 1]
-    return total
-
-
-@njit(cache=True, parallel=True)
-def aggregate(cost, sums, p1, p2):
-    """Fill sums (2, rows, cols, nd) with the forward and backward 4-path sums, in parallel."""
-    for k in prange(2):
-        _pass(cost, sums[k], k == 0, p1, p2)
-    return sums
+    return lo
 
 
 @njit(cache=True, fastmath=True, inline="always")
-def _wta(s, idx, n, uniqueness, fit):
-    """Best candidate of s[:n] (the smallest j among equal sums) and its sub-pixel offset in
-    px; -1 when the uniqueness test rejects it. idx = 0 .. nd in s's dtype."""
-    m = s[0]
+def _start(dst, c, nd):
+    """A path's first pixel: L = C; returns min L."""
+    lo = np.uint16(0xFFFF)
+    for j in range(nd):
+        dst[j + 1] = c[j]
+        lo = min(lo, c[j])
+    return lo
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _first_min(s, m, idx, n):
+    """(smallest j with s[j] == m, the minimum of s[:n], found as the row was summed; m): a
+    vectorised min reduction (idx = 0 .. len(s) in s's dtype, its last entry the largest)."""
+    big = idx[idx.size - 1]
+    best = big
     for j in range(n):
-        m = min(m, s[j])
-    best = idx[idx.size - 1]
-    for j in range(n):
-        best = min(best, idx[j] if s[j] == m else idx[idx.size - 1])
-    best = np.int64(best)
-    c0 = np.float32(m)
-    if uniqueness > 0.0:
-        bound = c0 * (1.0 + uniqueness / 100.0)
-        for j in range(n):
-            if (j < best - 1 or j > best + 1) and s[j] <= bound:
-                return -1, 0.0
-    off = 0.0
-    if fit != FIT_NONE and 0 < best < n - 1:
-        # candidates ascend in d here: the minimum lies at best + offset
-        off = fit_offset(np.float32(s[best - 1]), c0, np.float32(s[best + 1]), fit)
-    return best, off
+        best = min(best, idx[j] if s[j] == m else big)
+    return np.int64(best), np.float32(m)
 
 
-@njit(cache=True, parallel=True, fastmath=True)
-def decide(sums, dmin, uniqueness, fit, want_right):
-    """Left (and right) disparity maps in px, NaN where the uniqueness test rejects.
+@njit(cache=True, fastmath=True)
+def _decide_row(tot, mins, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc, acc16,
+                sh, idx, jj, fb):
+    """Left (and right) disparities of row y from its total path costs tot (cols, nd) and
+    their minima per pixel, mins.
 
-    Each row's total (forward + backward) is formed once in a row buffer; the right view's
-    candidates are that buffer's diagonals (right pixel xr at disparity d is left x = xr + d).
+    The smallest candidate among equal costs wins. The right view's candidates are tot's
+    diagonals (right pixel xr at candidate j is left pixel xr + dmin + j): each left pixel x
+    lowers acc[cols - x + j] to its cost << 16 | j if that is smaller (the same candidate
+    order, idx and jj = 0 .. nd in uint16 and uint32), so entry cols - dmin - xr ends as xr's
+    best; when sh > 0 every total fits in 16 - sh bits and acc16 takes cost << sh | j instead
+    (twice the vector lanes). The right view gets whole pixels (the LR check compares within a
+    pixel; its sub-pixel fit cost time and changed Cones and Teddy by under 0.1 %) and no
+    uniqueness test.
+    The left winners and their neighbours' costs go into fb (4, cols) float32 first, so the
+    sub-pixel fits run as one vector loop per row.
     """
-    _, h, w, nd = sums.shape
+    w, nd = tot.shape
+    for x in range(w):
+        s = tot[x]
+        best, c0 = _first_min(s, mins[x], idx, nd)
+        fb[0, x] = best
+        fb[2, x] = c0
+        inner = 0 < best < nd - 1
+        fb[1, x] = s[best - 1] if inner else c0  # no neighbours: a flat fit, offset 0
+        fb[3, x] = s[best + 1] if inner else c0
+        if uniqueness > 0.0:
+            bound = c0 * (1.0 + uniqueness / 100.0)
+            close = 0
+            for j in range(nd):
+                close += (j < best - 1 or j > best + 1) and s[j] <= bound
+            if close:
+                fb[0, x] = np.nan
+    _fit_row(fb, disp_l[y], dmin, fit, w)
+    if not want_right:
+        return
+    row = disp_r[y]
+    if sh > 0:
+        acc16[:] = np.uint16(0xFFFF)
+        for x in range(w):
+            s = tot[x]
+            a = acc16[w - x:w - x + nd]
+            for j in range(nd):
+                a[j] = min(a[j], np.uint16((s[j] << sh) | idx[j]))
+        mask = np.uint16((1 << sh) - 1)
+        for xr in range(w - dmin):
+            row[xr] = dmin + (acc16[w - dmin - xr] & mask)
+        return
+    acc[:] = np.uint32(0xFFFFFFFF)
+    for x in range(w):
+        s = tot[x]
+        a = acc[w - x:w - x + nd]
+        for j in range(nd):
+            a[j] = min(a[j], np.uint32((np.uint32(s[j]) << np.uint32(16)) | jj[j]))
+    for xr in range(w - dmin):
+        row[xr] = dmin + (acc[w - dmin - xr] & np.uint32(0xFFFF))
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _fit_row(fb, out, dmin, fit, n):
+    """out[:n] = dmin + winner + sub-pixel offset from fb (winner, cost before, at, after)."""
+    if fit == FIT_NONE:
+        for x in range(n):
+            out[x] = dmin + fb[0, x]
+    else:
+        for x in range(n):
+            out[x] = dmin + fb[0, x] + fit_offset(fb[1, x], fb[2, x], fb[3, x], fit)
+
+
+@njit(cache=True, fastmath=True)
+def _sweep(cl, crrev, vol, S, P, M, crow, tot, forward, i0, i1, p1, p2, diagonals, finish,
+           dmin, uniqueness, fit, want_right, disp_l, disp_r, acc, acc16, sh, keep):
+    """Rows i0 .. i1 - 1 (counted from the top when forward, else from the bottom) of one
+    direction's paths: path 0 from behind in the row, 2 from the row before at the same x,
+    and (diagonals) 1 and 3 from the row before at x - step and x + step.
+
+    P (2 row parities, 5 path slots, cols, nd + 2) and M (2, 5, cols) carry the path costs from
+    row to row, so one direction can stop at a row and go on from it in a later call. Without
+    finish the row's path sum goes into S; with finish it is added to S's row (the other
+    direction's sum) into tot and decided (and, with keep, stored back into S).
+    """
+    h, w = cl.shape
+    nd = S.shape[2]
+    step = 1 if forward else -1
+    idx = np.arange(nd + 1).astype(np.uint16)
+    jj = np.arange(nd + 1).astype(np.uint32)
+    fb = np.empty((4, w), dtype=np.float32)
+    mins = np.empty(w, dtype=np.uint16)
+    for i in range(i0, i1):
+        y = i if forward else h - 1 - i
+        _cost_row(cl, crrev, vol, y, dmin, crow)
+        b = i % 2
+        a = 1 - b
+        for t in range(w):
+            x = t if forward else w - 1 - t
+            c = crow[x]
+            h0 = P[b, 0, x]
+            v2 = P[b, 2, x]
+            if t == 0:
+                M[b, 0, x] = _start(h0, c, nd)
+            else:
+                M[b, 0, x] = _step(P[b, 0, x - step], M[b, 0, x - step], h0, c, p1, p2, nd)
+            if i == 0:
+                M[b, 2, x] = _start(v2, c, nd)
+            else:
+                M[b, 2, x] = _step(P[a, 2, x], M[a, 2, x], v2, c, p1, p2, nd)
+            if diagonals:
+                d1 = P[b, 1, x]
+                d3 = P[b, 3, x]
+                if i == 0 or t == 0:
+                    M[b, 1, x] = _start(d1, c, nd)
+                else:
+                    M[b, 1, x] = _step(P[a, 1, x - step], M[a, 1, x - step], d1, c, p1, p2, nd)
+                if i == 0 or t == w - 1:
+                    M[b, 3, x] = _start(d3, c, nd)
+                else:
+                    M[b, 3, x] = _step(P[a, 3, x + step], M[a, 3, x + step], d3, c, p1, p2, nd)
+                if finish:
+                    o = tot[x]
+                    s = S[y, x]
+                    lo = np.uint16(0xFFFF)
+                    for j in range(nd):
+                        v = np.uint16(s[j] + h0[j + 1] + d1[j + 1] + v2[j + 1] + d3[j + 1])
+                        o[j] = v
+                        lo = min(lo, v)
+                    mins[x] = lo
+                else:
+                    o = S[y, x]
+                    for j in range(nd):
+                        o[j] = h0[j + 1] + d1[j + 1] + v2[j + 1] + d3[j + 1]
+            elif finish:
+                o = tot[x]
+                s = S[y, x]
+                lo = np.uint16(0xFFFF)
+                for j in range(nd):
+                    v = np.uint16(s[j] + h0[j + 1] + v2[j + 1])
+                    o[j] = v
+                    lo = min(lo, v)
+                mins[x] = lo
+            else:
+                o = S[y, x]
+                for j in range(nd):
+                    o[j] = h0[j + 1] + v2[j + 1]
+        if finish:
+            _decide_row(tot, mins, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc,
+                        acc16, sh, idx, jj, fb)
+            if keep:
+                S[y] = tot
+
+
+OVERLAP = 24  # rows the lower stripe of the 5-path pass starts above its first row
+
+
+@njit(cache=True, fastmath=True)
+def _down(cl, crrev, vol, S, P, M, crow, tot, y0, y1, warm, p1, p2, dmin, uniqueness, fit,
+          want_right, disp_l, disp_r, acc, acc16, sh, keep):
+    """The 5-path pass over rows y0 .. y1 - 1, top to bottom: paths 1-3 from the top-left,
+    top and top-right and 0 from the left at x = t, 4 from the right at x = w - 1 - t, then
+    the row's sum is decided (with keep, stored in S). The three paths from above start warm
+    rows above y0 (those rows are not decided).
+    """
+    h, w = cl.shape
+    nd = crow.shape[1]
+    idx = np.arange(nd + 1).astype(np.uint16)
+    jj = np.arange(nd + 1).astype(np.uint32)
+    fb = np.empty((4, w), dtype=np.float32)
+    mins = np.empty(w, dtype=np.uint16)
+    for i in range(y1 - y0 + warm):
+        y = y0 - warm + i
+        decided = i >= warm
+        _cost_row(cl, crrev, vol, y, dmin, crow)
+        b = i % 2
+        a = 1 - b
+        for t in range(w):
+            x = t
+            c = crow[x]
+            if i == 0 or x == 0:
+                M[b, 1, x] = _start(P[b, 1, x], c, nd)
+            else:
+                M[b, 1, x] = _step(P[a, 1, x - 1], M[a, 1, x - 1], P[b, 1, x], c, p1, p2, nd)
+            if i == 0:
+                M[b, 2, x] = _start(P[b, 2, x], c, nd)
+            else:
+                M[b, 2, x] = _step(P[a, 2, x], M[a, 2, x], P[b, 2, x], c, p1, p2, nd)
+            if i == 0 or x == w - 1:
+                M[b, 3, x] = _start(P[b, 3, x], c, nd)
+            else:
+                M[b, 3, x] = _step(P[a, 3, x + 1], M[a, 3, x + 1], P[b, 3, x], c, p1, p2, nd)
+            if not decided:
+                continue
+            # the two paths along the row are chains (each step waits for the one before):
+            # stepping both here lets the processor overlap them with the three above
+            if x == 0:
+                M[b, 0, x] = _start(P[b, 0, x], c, nd)
+            else:
+                M[b, 0, x] = _step(P[b, 0, x - 1], M[b, 0, x - 1], P[b, 0, x], c, p1, p2, nd)
+            x = w - 1 - t
+            c = crow[x]
+            if x == w - 1:
+                M[b, 4, x] = _start(P[b, 4, x], c, nd)
+            else:
+                M[b, 4, x] = _step(P[b, 4, x + 1], M[b, 4, x + 1], P[b, 4, x], c, p1, p2, nd)
+        if not decided:
+            continue
+        for x in range(w):
+            o = tot[x]
+            h0 = P[b, 0, x]
+            d1 = P[b, 1, x]
+            v2 = P[b, 2, x]
+            d3 = P[b, 3, x]
+            h4 = P[b, 4, x]
+            lo = np.uint16(0xFFFF)
+            for j in range(nd):
+                v = np.uint16(h0[j + 1] + d1[j + 1] + v2[j + 1] + d3[j + 1] + h4[j + 1])
+                o[j] = v
+                lo = min(lo, v)
+            mins[x] = lo
+        _decide_row(tot, mins, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc,
+                        acc16, sh, idx, jj, fb)
+        if keep:
+            S[y] = tot
+
+
+@njit(cache=True, parallel=True)
+def match(cl, crrev, vol, S, dmin, p1, p2, paths, uniqueness, fit, want_right, keep):
+    """Semi-global matching of census images cl and crrev (see _cost_row): disparity maps of
+    the left and (want_right) right view in px, NaN where the uniqueness test rejects.
+
+    vol: box-summed cost (rows, cols, nd), or an empty volume to take the Hamming cost from
+    the census rows. S (rows, cols, nd) uint16 holds one direction's path sums: the forward
+    direction (paths from the left and, with 8 paths, top-left, top, top-right; with 4, top)
+    sweeps the upper half while the backward one sweeps the lower half from the bottom, each
+    storing its sums; then each goes on into the other's half, adds its own paths to the
+    stored sums and decides the row. So each half of S is written once and read once, every
+    cost row is made where it is used, and with two threads the two directions run at once.
+    With 5 paths (left, right, top-left, top, top-right) one pass from the top decides each
+    row as it goes and S is not used: the image is cut into an upper and a lower stripe (one
+    per thread), and the lower stripe's paths from above start OVERLAP rows above it, the same
+    whatever the thread count, so results do not depend on it.
+    keep: leave the total path costs in S (rows, cols, nd; for tests).
+    """
+    h, w = cl.shape
+    nd = S.shape[2]
+    P = np.empty((2, 2, 5, w, nd + 2), dtype=np.uint16)
+    P[:, :, :, :, 0] = PAD
+    P[:, :, :, :, nd + 1] = PAD
+    M = np.zeros((2, 2, 5, w), dtype=np.uint16)
+    crow = np.empty((2, w, nd), dtype=np.uint16)
+    tot = np.empty((2, w, nd), dtype=np.uint16)
+    acc = np.empty((2, w + nd), dtype=np.uint32)
+    acc16 = np.empty((2, w + nd), dtype=np.uint16)
+    # a path cost is at most the largest cost + P2, so every total is under paths times that:
+    # if it fits with the candidate's bits below it, the right view's minimum runs in uint16
+    bits = 0
+    while (1 << bits) < nd:
+        bits += 1
+    cmax = CENSUS_BITS if vol.shape[0] == 0 else int(vol.max())
+    sh = bits if bits > 0 and (paths * (cmax + int(p2)) + 1) << bits <= 0xFFFF else 0
     disp_l = np.full((h, w), np.nan, dtype=np.float32)
     disp_r = np.full((h, w), np.nan, dtype=np.float32)
-    for y in prange(h):
-        row = np.empty((w, nd), dtype=np.uint16)
-        s = np.empty(nd, dtype=np.uint16)
-        idx = np.arange(nd + 1).astype(np.uint16)
-        for x in range(w):
-            for j in range(nd):
-                row[x, j] = sums[0, y, x, j] + sums[1, y, x, j]
-            for j in range(nd):
-                s[j] = row[x, j]
-            best, off = _wta(s, idx, nd, uniqueness, fit)
-            if best >= 0:
-                disp_l[y, x] = dmin + best + off
-        if want_right:
-            for xr in range(w):
-                n = min(nd, w - xr - dmin)
-                if n <= 0:
-                    continue
-                for j in range(n):
-                    s[j] = row[xr + dmin + j, j]
-                best, off = _wta(s, idx, n, 0.0, fit)
-                disp_r[y, xr] = dmin + best + off
+    upper = (h + 1) // 2
+    if paths == 5:
+        for k in prange(2):
+            y0, y1 = (0, upper) if k == 0 else (upper, h)
+            _down(cl, crrev, vol, S, P[k], M[k], crow[k], tot[k], y0, y1,
+                  0 if k == 0 else min(OVERLAP, upper), p1, p2, dmin, uniqueness, fit,
+                  want_right, disp_l, disp_r, acc[k], acc16[k], sh, keep)
+        return disp_l, disp_r
+    diagonals = paths == 8
+    for phase in range(2):
+        for k in prange(2):
+            forward = k == 0
+            if phase == 0:
+                i0, i1 = 0, upper if forward else h - upper
+            else:
+                i0, i1 = upper if forward else h - upper, h
+            _sweep(cl, crrev, vol, S, P[k], M[k], crow[k], tot[k], forward, i0, i1, p1, p2,
+                   diagonals, phase == 1, dmin, uniqueness, fit, want_right, disp_l, disp_r,
+                   acc[k], acc16[k], sh, keep)
     return disp_l, disp_r
+
+
+def reversed_right(cr: np.ndarray, dmin: int, nd: int) -> np.ndarray:
+    """The right census with each row reversed and nd + dmin zeros after it (see _cost_row)."""
+    h, w = cr.shape
+    out = np.zeros((h, w + dmin + nd), dtype=np.uint64)
+    out[:, :w] = cr[:, ::-1]
+    return out

@@ -6,9 +6,11 @@ from __future__ import annotations
 from pathlib import Path
 
 import cv2
+import numba
 import numpy as np
 import pytest
 
+from host.errors import HostError
 from host.stereo import MatcherParams, compute_disparity, evaluate, load_scene, sgm
 from host.stereo.synthetic import Layer, random_texture, render_pair, synthetic_scene
 
@@ -37,12 +39,17 @@ def test_census_bits_say_which_neighbours_are_darker() -> None:
         assert int(got[y, x]) == bits
 
 
-def _naive_paths(cost: np.ndarray, p1: int, p2: int) -> np.ndarray:
-    # Hirschmueller's recurrence along the 8 directions, written out plainly
+EIGHT = [(0, 1), (1, 1), (1, 0), (1, -1), (0, -1), (-1, -1), (-1, 0), (-1, 1)]
+FOUR = [(0, 1), (1, 0), (0, -1), (-1, 0)]
+FIVE = [(0, 1), (0, -1), (1, 1), (1, 0), (1, -1)]
+
+
+def _naive_paths(cost: np.ndarray, p1: int, p2: int, dirs: list[tuple[int, int]]) -> np.ndarray:
+    # Hirschmueller's recurrence along the given (dy, dx) directions, written out plainly
     h, w, nd = cost.shape
     c = cost.astype(np.int64)
     total = np.zeros_like(c)
-    for dy, dx in [(0, 1), (1, 1), (1, 0), (1, -1), (0, -1), (-1, -1), (-1, 0), (-1, 1)]:
+    for dy, dx in dirs:
         lr = np.zeros_like(c)
         ys = range(h) if dy >= 0 else range(h - 1, -1, -1)
         xs = list(range(w)) if dx >= 0 else list(range(w - 1, -1, -1))
@@ -65,21 +72,85 @@ def _naive_paths(cost: np.ndarray, p1: int, p2: int) -> np.ndarray:
     return total
 
 
-def test_eight_path_aggregation_equals_the_plain_recurrence() -> None:
+def _match(cost: np.ndarray, p1: int, p2: int, paths: int, dmin: int = 0, fit: int = 0):
+    """sgm.match on a given cost volume; returns (left, right, total path costs)."""
+    h, w, nd = cost.shape
+    none = np.zeros((h, w), np.uint64)  # census images unused: the cost volume is given
+    total = np.empty_like(cost)
+    left, right = sgm.match(none, sgm.reversed_right(none, dmin, nd), cost, total, dmin,
+                            np.uint16(p1), np.uint16(p2), paths, 0.0, fit, True, True)
+    return left, right, total
+
+
+@pytest.mark.parametrize(("paths", "dirs"), [(8, EIGHT), (5, FIVE), (4, FOUR)])
+@pytest.mark.parametrize("shape", [(6, 7, 5), (9, 5, 8)])
+def test_path_aggregation_equals_the_plain_recurrence(paths, dirs, shape) -> None:
+    # odd and even row counts: the two directions meet in the middle row
     rng = np.random.default_rng(4)
-    cost = rng.integers(0, 63, (6, 7, 5)).astype(np.uint16)
-    sums = np.empty((2, *cost.shape), np.uint16)
-    sgm.aggregate(cost, sums, np.uint16(7), np.uint16(30))
-    got = sums[0].astype(np.int64) + sums[1]
-    np.testing.assert_array_equal(got, _naive_paths(cost, 7, 30))
+    cost = rng.integers(0, 63, shape).astype(np.uint16)
+    _, _, total = _match(cost, 7, 30, paths)
+    np.testing.assert_array_equal(total, _naive_paths(cost, 7, 30, dirs))
 
 
+def test_five_path_lower_stripe_starts_its_paths_from_above_overlap_rows_up() -> None:
+    # the one-pass 5-path aggregation cuts the image in two stripes; the lower one's paths
+    # from above start sgm.OVERLAP rows above it, so its rows equal the plain recurrence
+    # over the image from there down
+    rng = np.random.default_rng(6)
+    h = 2 * sgm.OVERLAP + 10
+    cost = rng.integers(0, 63, (h, 9, 5)).astype(np.uint16)
+    _, _, total = _match(cost, 7, 30, 5)
+    upper = (h + 1) // 2
+    np.testing.assert_array_equal(total[:upper], _naive_paths(cost, 7, 30, FIVE)[:upper])
+    below = _naive_paths(cost[upper - sgm.OVERLAP:], 7, 30, FIVE)[sgm.OVERLAP:]
+    np.testing.assert_array_equal(total[upper:], below)
+
+
+@pytest.mark.parametrize("paths", [8, 5, 4])
+def test_sgm_gives_the_same_map_on_one_and_two_threads(paths: int) -> None:
+    scene = synthetic_scene(seed=3, noise=0.5)
+    p = SGM.replace(num_disparities=48, paths=paths, lr_check=1.0, uniqueness_ratio=5)
+    before = numba.get_num_threads()
+    try:
+        maps = []
+        for threads in (1, 2):
+            numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+            maps.append(compute_disparity(scene.left, scene.right, p))
+    finally:
+        numba.set_num_threads(before)
+    np.testing.assert_array_equal(maps[0], maps[1])
+
+
+@pytest.mark.parametrize("p2", [12, 3000])  # totals in 13 bits (uint16 packing) or not
+@pytest.mark.parametrize("paths", [8, 5, 4])
+def test_both_maps_are_the_first_minimum_of_the_total_along_rows_and_diagonals(paths, p2) -> None:
+    # the right map comes from the same summed costs as the left one: right pixel xr at
+    # disparity d is left pixel xr + d (no second, right-referenced aggregation)
+    rng = np.random.default_rng(8)
+    cost = rng.integers(0, 20, (7, 30, 6)).astype(np.uint16)
+    dmin = 2
+    left, right, _ = _match(cost, 3, p2, paths, dmin=dmin)
+    total = _naive_paths(cost, 3, p2, {8: EIGHT, 5: FIVE, 4: FOUR}[paths])
+    h, w, nd = cost.shape
+    for y in range(h):
+        for x in range(w):
+            assert left[y, x] == dmin + np.argmin(total[y, x])
+        for xr in range(w):
+            n = min(nd, w - xr - dmin)
+            if n <= 0:
+                assert np.isnan(right[y, xr])
+                continue
+            diagonal = [total[y, xr + dmin + j, j] for j in range(n)]
+            assert right[y, xr] == dmin + np.argmin(diagonal)
+
+
+@pytest.mark.parametrize("paths", [8, 5, 4])
 @pytest.mark.parametrize("d", [6.0, 13.5, 21.25])
-def test_sgm_recovers_a_known_shift(d: float) -> None:
+def test_sgm_recovers_a_known_shift(d: float, paths: int) -> None:
     rng = np.random.default_rng(1)
     tex = random_texture(rng, 90, 240, sigma=1.2)
     scene = render_pair([Layer(d, tex, margin=40)], 160, 90, noise=0.0)
-    disp = compute_disparity(scene.left, scene.right, SGM)
+    disp = compute_disparity(scene.left, scene.right, SGM.replace(paths=paths))
     inside = disp[5:-5, int(np.ceil(d)) + 6:-5]
     assert np.isfinite(inside).all()
     assert (np.abs(inside - d) <= 0.5).mean() > 0.97, np.percentile(np.abs(inside - d), 97)
@@ -114,6 +185,11 @@ def test_sgm_lr_check_removes_occluded_pixels() -> None:
     assert np.isnan(checked[occluded]).mean() > 0.6
     visible = scene.masks["nonocc"]
     assert np.isfinite(checked[visible]).mean() > 0.9
+
+
+def test_sgm_path_count_other_than_4_5_or_8_is_refused() -> None:
+    with pytest.raises(HostError, match="paths must be 4, 5 or 8"):
+        SGM.replace(paths=6).validate()
 
 
 def test_sgm_border_invalid_leaves_the_census_margin_empty() -> None:
