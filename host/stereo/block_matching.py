@@ -149,18 +149,15 @@ def _pack_shift(kind, nd, size, channels):
     return bits if top < (1 << (31 - bits)) else -1
 
 
-@njit(cache=True, parallel=True, fastmath=True)
-def match_rows(left, right, dmin, nd, half, kind, uniqueness, subpixel, want_right, clip,
-               sum_l, sq_l, sum_r, sq_r):
-    """Disparity maps (left, right) for uint8 images shaped (channels, rows, cols).
-
-    The cost of a window is summed over channels (NCC takes one channel). clip: windows at the
-    image edge are cropped to the image instead of making the pixel invalid. dmin >= 0.
-    """
+@njit(cache=True)
+def padded_pair(left, right, dmin, nd, half, clip):
+    """What both block-matching kernels start from: NaN maps (left, right), the images padded
+    (rows of zeros above and below when clip, so clipped window sums are exact: 0 against 0
+    costs nothing; room for every candidate left and right of the right view), the right
+    view's column offset, the rows of window centres and the columns [x_start, x_end)."""
     nch, h, w = left.shape
     disp_l = np.full((h, w), np.nan, dtype=np.float32)
     disp_r = np.full((h, w), np.nan, dtype=np.float32)
-    # zero rows above and below make clipped window sums exact: 0 against 0 costs nothing
     ro = half if clip else 0
     pad = nd + dmin + 1
     left_p = np.zeros((nch, h + 2 * ro, w), dtype=np.uint8)
@@ -170,6 +167,21 @@ def match_rows(left, right, dmin, nd, half, kind, uniqueness, subpixel, want_rig
     rows = h + 2 * ro - 2 * half
     x_start = 0 if clip else half
     x_end = w if clip else w - half
+    return disp_l, disp_r, left_p, right_p, pad, rows, x_start, x_end
+
+
+@njit(cache=True, parallel=True, fastmath=True)
+def match_rows(left, right, dmin, nd, half, kind, uniqueness, subpixel, want_right, clip,
+               sum_l, sq_l, sum_r, sq_r):
+    """Disparity maps (left, right) for uint8 images shaped (channels, rows, cols).
+
+    The cost of a window is summed over channels (NCC takes one channel). clip: windows at the
+    image edge are cropped to the image instead of making the pixel invalid. dmin >= 0.
+    """
+    nch, h, w = left.shape
+    disp_l, disp_r, left_p, right_p, pad, rows, x_start, x_end = padded_pair(left, right, dmin,
+                                                                           nd, half, clip)
+    ro = half if clip else 0  # the zero rows padded_pair put above the image
     if rows <= 0 or x_end <= x_start:
         return disp_l, disp_r
     shift = _pack_shift(kind, nd, 2 * half + 1, nch)

@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from host.stereo.block_matching import _argmin  # the first minimum over candidates kmin..nd
+from host.stereo.block_matching import _argmin, padded_pair  # first minimum; padded images
 from host.stereo.subpixel import FIT_NONE, fit_offset
 
 TILE_BYTES = 8192  # column sums updated per tile: well inside a 32 KiB L1 with the pixel rows
@@ -204,17 +204,9 @@ def match_sad(left, right, dmin, nd, half, uniqueness, fit, want_right, clip, co
     thread (numba.get_num_threads()).
     """
     nch, h, w = left.shape
-    disp_l = np.full((h, w), np.nan, dtype=np.float32)
-    disp_r = np.full((h, w), np.nan, dtype=np.float32)
-    ro = half if clip else 0  # zero rows above and below keep clipped sums exact
-    pad = nd + dmin + 1
-    left_p = np.zeros((nch, h + 2 * ro, w), dtype=np.uint8)
-    left_p[:, ro:ro + h, :] = left
-    right_p = np.zeros((nch, h + 2 * ro, w + 2 * pad), dtype=np.uint8)
-    right_p[:, ro:ro + h, pad:pad + w] = right
-    rows = h + 2 * ro - 2 * half
-    x_start = 0 if clip else half
-    x_end = w if clip else w - half
+    disp_l, disp_r, left_p, right_p, pad, rows, x_start, x_end = padded_pair(left, right, dmin,
+                                                                           nd, half, clip)
+    ro = half if clip else 0  # the zero rows padded_pair put above the image
     if rows <= 0 or x_end <= x_start:
         return disp_l, disp_r
     base0 = pad - dmin - (nd - 1)
