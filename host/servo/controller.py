@@ -17,11 +17,19 @@ while the fitted error stays within tolerance_m and moves again beyond it.
 Turn: spin until the marker, lost edge-on, is seen again; the card's apparent aspect (width /
 height = |cos| of its angle) when it was lost and when it returned, and the time between, give
 the turn rate actually achieved; the spin goes on for the remaining angle at that rate (an
-absence shorter than min_gap_s is a flicker, not the card's back). Then re-acquisition: driving
-waits for the marker; if the card never came back in the turn, the robot spins slowly on to
-find it.
-Sideways drift of the marker's position x = B (u - cx) / d from where it was first seen, and its
-rate, steer the robot back (PD).
+absence shorter than min_gap_s, or one that began and ended with the card still facing the
+camera - aspect above edge_aspect - is a missed detection, not the card's back). Then
+re-acquisition: driving waits for the marker; if the card never came back in the turn, the
+robot spins slowly on to find it.
+Lateral: the marker's position x = B (u - cx) / d is held on a lane: where it was first seen,
+unless that line passes the object (keep_out, the object's lateral extent at its depth, from the
+servo) closer than clearance_m, centre to side; then the lane moves to the nearer clear side.
+The drift from the lane and its rate steer the robot (PD, scaled with the duty, off while the
+robot barely moves: its heading then cannot be seen), and a trim learnt from the drift while
+driving (an integral, as a fraction of the duty) cancels the wheels' unequal gains. When the
+robot comes within block_m of the object's depth while its body still overlaps the object, it
+stops: "the robot's line passes through the object". A robot pushed sideways onto the object
+while it holds stops the run the same way (it cannot move sideways standing still).
 
 Safety: an invalid observation (no marker, stale or skewed frame) stops the robot at once;
 after lost_frames of them the phase is "lost" (stopped) until the marker returns.
@@ -34,8 +42,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-WAIT, HOLD, DRIVE, CREEP, TURN, LOST, STALE, SEARCH = ("wait", "hold", "drive", "creep", "turn",
-                                                        "lost", "stale", "search")
+WAIT, HOLD, DRIVE, CREEP, TURN, LOST, STALE, SEARCH, BLOCKED = (
+    "wait", "hold", "drive", "creep", "turn", "lost", "stale", "search", "blocked")
+LINE_BLOCKED = "the robot's line passes through the object"
+PUSHED = "pushed sideways onto the object while holding"
 
 
 @dataclass(frozen=True)
@@ -51,10 +61,17 @@ class ControlConfig:
     fit_frames: int = 6
     steer_gain: float = 25.0  # permille per cm of sideways drift
     steer_damping: float = 60.0  # permille per cm/s of sideways drift rate
+    trim_gain: float = 0.004  # learnt wheel trim, fraction of duty per cm of drift per second
+    max_trim: float = 0.25
+    half_width_m: float = 0.08  # the robot's body, centre to side
+    clearance_m: float = 0.15  # the lane's distance from the object's side: half the body,
+    # and room for the lateral hold error and a sideways drift while holding
+    block_m: float = 0.15  # within this depth of the object, the body must be clear of it
     mode: str = "turn"  # or "reverse"
     turn_duty: int = 400
     turn_timeout_s: float = 8.0
     min_gap_s: float = 0.3  # the card is edge-on at least this long in a turn (a flicker is not)
+    edge_aspect: float = 0.8  # lost and found again both above this aspect: not edge-on
     search_duty: int = 300  # spin to find the marker again when it is lost after a turn
     search_s: float = 8.0
     lost_frames: int = 3
@@ -95,7 +112,11 @@ class Controller:
         self.seen = False
         self.missing = 0
         self.floor = config.min_duty
-        self.lateral_ref: float | None = None
+        self.lateral_ref: float | None = None  # the lane the robot holds (m)
+        self.keep_out: tuple[float, float] | None = None  # the object's lateral extent (m)
+        self.trim = 0.0  # fraction of duty added to the right wheel, taken from the left
+        self.fault = ""  # why the robot must stay stopped (the run ends), "" if none
+        self._last_t: float | None = None
         self.history: list[Observation] = []  # valid observations since the last turn
         self._turn: dict | None = None
         self._search_until: float | None = None
@@ -125,7 +146,29 @@ class Controller:
 
     # ------------------------------------------------------------------------- update
 
+    def lane(self) -> float | None:
+        """The lateral position to hold: the first seen, moved clear of the object."""
+        x = self.lateral_ref
+        if x is None or self.keep_out is None:
+            return x
+        x0, x1 = self.keep_out
+        lo, hi = x0 - self.cfg.clearance_m, x1 + self.cfg.clearance_m
+        if lo < x < hi:
+            return lo if x - lo < hi - x else hi
+        return x
+
+    def overlaps(self, lateral: float | None, margin: float = 0.01) -> bool:
+        """Whether the robot's body at this lateral position comes within margin of the
+        object's extent."""
+        if lateral is None or self.keep_out is None:
+            return False
+        x0, x1 = self.keep_out
+        reach = self.cfg.half_width_m + margin
+        return x0 - reach < lateral < x1 + reach
+
     def update(self, obs: Observation) -> Command:
+        if self.fault:
+            return self._stop(BLOCKED, None)
         if self._turn is not None:
             return self._turning(obs)
         if obs.depth_m is None:
@@ -156,6 +199,12 @@ class Controller:
         z, zdot, xdot = self.fit() or (obs.depth_m or 0.0, 0.0, 0.0)
         e = z - self.target_m
         away = e < 0
+        dt = obs.t - self._last_t if self._last_t is not None else 0.0
+        self._last_t = obs.t
+        holding = self.phase == HOLD
+        if abs(e) < cfg.block_m and self.overlaps(obs.lateral_m, 0.03 if holding else 0.01):
+            self.fault = PUSHED if holding else LINE_BLOCKED
+            return self._stop(BLOCKED, e)
         if self.phase == HOLD and abs(e) <= cfg.tolerance_m:
             return self._stop(HOLD, e)
         moving_in = self.phase in (DRIVE, CREEP)
@@ -174,13 +223,22 @@ class Controller:
         duty = self.floor if creeping else min(cfg.max_duty, int(self.floor + gain * abs(e)))
         duty = duty if forward else -duty
         steer = 0.0
-        if obs.lateral_m is not None and self.lateral_ref is not None:
+        lane = self.lane()
+        if obs.lateral_m is not None and lane is not None:
             # x' = v sin(theta): to cancel a drift to the right, turn so that v cos(theta) * dtheta
             # is negative; v cos(theta) is positive exactly when moving away from the camera
             s = 1.0 if away else -1.0
-            drift = obs.lateral_m - self.lateral_ref
-            steer = s * (cfg.steer_gain * 100 * drift + cfg.steer_damping * 100 * xdot) / 2
-            steer = max(-abs(duty) * 0.6, min(abs(duty) * 0.6, steer))
+            drift = obs.lateral_m - lane
+            moving = abs(zdot) > 0.02  # the heading shows only in motion
+            if moving and self.phase == DRIVE and 0 < dt < 0.5:
+                # the wheel that lags stays the same one whichever way the robot faces
+                w = s if forward else -s
+                self.trim = max(-cfg.max_trim, min(cfg.max_trim, self.trim + w * cfg.trim_gain
+                                                   * 100 * max(-0.05, min(0.05, drift)) * dt))
+            pd = s * (cfg.steer_gain * 100 * drift + cfg.steer_damping * 100 * xdot) / 2
+            pd = pd * abs(duty) / cfg.max_duty if moving else 0.0
+            limit = abs(duty) * (0.25 if creeping else 0.5)
+            steer = max(-limit, min(limit, pd)) + self.trim * duty
         self.phase = CREEP if creeping else DRIVE
         return Command(int(round(duty - steer)), int(round(duty + steer)), self.phase, e)
 
@@ -214,6 +272,11 @@ class Controller:
         elif seen and turn["lost_t"] is not None and obs.t - turn["lost_t"] >= cfg.min_gap_s:
             a_lost = min(1.0, turn["lost_aspect"])
             a_now = min(1.0, obs.aspect)
+            if min(a_lost, a_now) > cfg.edge_aspect:
+                # lost and found again facing the camera: a missed detection (far, blurred),
+                # not the card going edge-on and coming back from its other side
+                turn["lost_t"], turn["last_seen"] = None, (obs.t, obs.aspect)
+                return self._spin(None)
             swept = math.pi - math.acos(a_lost) - math.acos(a_now)
             rate = swept / max(obs.t - turn["lost_t"], 1e-3)
             remaining = math.acos(a_now) / rate - self.cfg.stop_lead_s
