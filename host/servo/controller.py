@@ -17,9 +17,8 @@ while the fitted error stays within tolerance_m and moves again beyond it.
 Turn: spin until the marker, lost edge-on, is seen again; the card's apparent aspect (width /
 height = |cos| of its angle) when it was lost and when it returned, and the time between, give
 the turn rate actually achieved; the spin goes on for the remaining angle at that rate (an
-absence shorter than min_gap_s, or one that began and ended with the card still facing the
-camera - aspect above edge_aspect - is a missed detection, not the card's back). Then
-re-acquisition: driving waits for the marker; if the card never came back in the turn, the
+absence shorter than min_gap_s is a missed detection, not the card's back, and is forgotten).
+Then re-acquisition: driving waits for the marker; if the card never came back in the turn, the
 robot spins slowly on to find it.
 Lateral: the marker's position x = B (u - cx) / d is held on a lane: where it was first seen,
 unless that line passes the object (keep_out, the object's lateral extent at its depth, from the
@@ -67,11 +66,11 @@ class ControlConfig:
     clearance_m: float = 0.15  # the lane's distance from the object's side: half the body,
     # and room for the lateral hold error and a sideways drift while holding
     block_m: float = 0.15  # within this depth of the object, the body must be clear of it
+    block_margin_m: float = 0.02  # by this much (the object's edge is measured to a pixel or two)
     mode: str = "turn"  # or "reverse"
     turn_duty: int = 400
     turn_timeout_s: float = 8.0
     min_gap_s: float = 0.3  # the card is edge-on at least this long in a turn (a flicker is not)
-    edge_aspect: float = 0.8  # lost and found again both above this aspect: not edge-on
     search_duty: int = 300  # spin to find the marker again when it is lost after a turn
     search_s: float = 8.0
     lost_frames: int = 3
@@ -157,7 +156,7 @@ class Controller:
             return lo if x - lo < hi - x else hi
         return x
 
-    def overlaps(self, lateral: float | None, margin: float = 0.01) -> bool:
+    def overlaps(self, lateral: float | None, margin: float = 0.0) -> bool:
         """Whether the robot's body at this lateral position comes within margin of the
         object's extent."""
         if lateral is None or self.keep_out is None:
@@ -201,9 +200,8 @@ class Controller:
         away = e < 0
         dt = obs.t - self._last_t if self._last_t is not None else 0.0
         self._last_t = obs.t
-        holding = self.phase == HOLD
-        if abs(e) < cfg.block_m and self.overlaps(obs.lateral_m, 0.03 if holding else 0.01):
-            self.fault = PUSHED if holding else LINE_BLOCKED
+        if abs(e) < cfg.block_m and self.overlaps(obs.lateral_m, cfg.block_margin_m):
+            self.fault = PUSHED if self.phase == HOLD else LINE_BLOCKED
             return self._stop(BLOCKED, e)
         if self.phase == HOLD and abs(e) <= cfg.tolerance_m:
             return self._stop(HOLD, e)
@@ -269,14 +267,13 @@ class Controller:
             turn["last_seen"] = (obs.t, obs.aspect)
         elif not seen and turn["lost_t"] is None and not obs.invalid:
             turn["lost_t"], turn["lost_aspect"] = turn["last_seen"]
-        elif seen and turn["lost_t"] is not None and obs.t - turn["lost_t"] >= cfg.min_gap_s:
+        elif seen and turn["lost_t"] is not None and obs.t - turn["lost_t"] < cfg.min_gap_s:
+            # back within min_gap_s: a missed detection, not the card's back; forget the loss,
+            # or a later sighting (min_gap_s after it) would end the turn there
+            turn["lost_t"], turn["last_seen"] = None, (obs.t, obs.aspect)
+        elif seen and turn["lost_t"] is not None:
             a_lost = min(1.0, turn["lost_aspect"])
             a_now = min(1.0, obs.aspect)
-            if min(a_lost, a_now) > cfg.edge_aspect:
-                # lost and found again facing the camera: a missed detection (far, blurred),
-                # not the card going edge-on and coming back from its other side
-                turn["lost_t"], turn["last_seen"] = None, (obs.t, obs.aspect)
-                return self._spin(None)
             swept = math.pi - math.acos(a_lost) - math.acos(a_now)
             rate = swept / max(obs.t - turn["lost_t"], 1e-3)
             remaining = math.acos(a_now) / rate - self.cfg.stop_lead_s
