@@ -23,9 +23,10 @@ robot spins slowly on to find it.
 Lateral: the marker's position x = B (u - cx) / d is held on a lane: where it was first seen,
 unless that line passes the object (keep_out, the object's lateral extent at its depth, from the
 servo) closer than clearance_m, centre to side; then the lane moves to the nearer clear side.
-The drift from the lane and its rate steer the robot (PD, scaled with the duty, off while the
-robot barely moves: its heading then cannot be seen), and a trim learnt from the drift while
-driving (an integral, as a fraction of the duty) cancels the wheels' unequal gains. When the
+The drift from the lane and its rate steer the robot (PD, at most half the duty; not while
+creeping, where the drift rate is mostly a sideways push rather than heading), and a trim learnt
+from the drift while driving (an integral, as a fraction of the duty) cancels the wheels'
+unequal gains; no wheel is commanded below the least duty that moves it. When the
 robot comes within block_m of the object's depth while its body still overlaps the object, it
 stops: "the robot's line passes through the object". A robot pushed sideways onto the object
 while it holds stops the run the same way (it cannot move sideways standing still).
@@ -234,11 +235,17 @@ class Controller:
                 self.trim = max(-cfg.max_trim, min(cfg.max_trim, self.trim + w * cfg.trim_gain
                                                    * 100 * max(-0.05, min(0.05, drift)) * dt))
             pd = s * (cfg.steer_gain * 100 * drift + cfg.steer_damping * 100 * xdot) / 2
-            pd = pd * abs(duty) / cfg.max_duty if moving else 0.0
-            limit = abs(duty) * (0.25 if creeping else 0.5)
-            steer = max(-limit, min(limit, pd)) + self.trim * duty
+            # creeping (the last few cm) the drift rate is mostly a sideways push, not heading:
+            # steering against it turns the robot off the card's visible range and, near the
+            # dead zone, spins it in place; only the wheels' trim acts there
+            steer = (0.0 if creeping else max(-abs(duty) / 2, min(abs(duty) / 2, pd)))
+            steer += self.trim * duty
         self.phase = CREEP if creeping else DRIVE
-        return Command(int(round(duty - steer)), int(round(duty + steer)), self.phase, e)
+        left, right = duty - steer, duty + steer
+        lift = self.floor - min(abs(left), abs(right))  # no wheel below the least duty that moves
+        if lift > 0:
+            left, right = left + math.copysign(lift, duty), right + math.copysign(lift, duty)
+        return Command(int(round(left)), int(round(right)), self.phase, e)
 
     # --------------------------------------------------------------------------- turn
 
