@@ -77,6 +77,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--nominal", action="store_true",
                    help="with --trials: the world without faults")
     p.add_argument("--workers", type=COUNT, default=2, help="with --trials: processes")
+    p.add_argument("--trial-index", type=int_range(0, 1_000_000), action="append",
+                   metavar="I", help="with --trials: run only trial I of them (repeatable), "
+                   "to reproduce one")
     p.add_argument("--drop", type=FRACTION, default=0.0, help="sim: byte drop probability")
     p.add_argument("--corrupt", type=FRACTION, default=0.0,
                    help="sim: byte corruption probability")
@@ -176,7 +179,8 @@ def _run_sim(args) -> int:
         from host.sim.trials import run_trials
 
         return run_trials(args.trials, args.seed, parse_size(args.size), params, args.json,
-                          workers=args.workers, nominal=args.nominal)
+                          workers=args.workers, nominal=args.nominal,
+                          indices=args.trial_index)
     faults = WorldFaults()
     if args.faults:
         faults = random_faults(np.random.default_rng(args.seed), 1.2)

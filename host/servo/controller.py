@@ -17,11 +17,19 @@ while the fitted error stays within tolerance_m and moves again beyond it.
 Turn: spin until the marker, lost edge-on, is seen again; the card's apparent aspect (width /
 height = |cos| of its angle) when it was lost and when it returned, and the time between, give
 the turn rate actually achieved; the spin goes on for the remaining angle at that rate (an
-absence shorter than min_gap_s is a flicker, not the card's back). Then re-acquisition: driving
-waits for the marker; if the card never came back in the turn, the robot spins slowly on to
-find it.
-Sideways drift of the marker's position x = B (u - cx) / d from where it was first seen, and its
-rate, steer the robot back (PD).
+absence shorter than min_gap_s is a missed detection, not the card's back, and is forgotten).
+Then re-acquisition: driving waits for the marker; if the card never came back in the turn, the
+robot spins slowly on to find it.
+Lateral: the marker's position x = B (u - cx) / d is held on a lane: where it was first seen,
+unless that line passes the object (keep_out, the object's lateral extent at its depth, from the
+servo) closer than clearance_m, centre to side; then the lane moves to the nearer clear side.
+The drift from the lane and its rate steer the robot (PD, at most half the duty; not while
+creeping, where the drift rate is mostly a sideways push rather than heading), and a trim learnt
+from the drift while driving (an integral, as a fraction of the duty) cancels the wheels'
+unequal gains; no wheel is commanded below the least duty that moves it. When the
+robot comes within block_m of the object's depth while its body still overlaps the object, it
+stops: "the robot's line passes through the object". A robot pushed sideways onto the object
+while it holds stops the run the same way (it cannot move sideways standing still).
 
 Safety: an invalid observation (no marker, stale or skewed frame) stops the robot at once;
 after lost_frames of them the phase is "lost" (stopped) until the marker returns.
@@ -34,8 +42,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-WAIT, HOLD, DRIVE, CREEP, TURN, LOST, STALE, SEARCH = ("wait", "hold", "drive", "creep", "turn",
-                                                        "lost", "stale", "search")
+WAIT, HOLD, DRIVE, CREEP, TURN, LOST, STALE, SEARCH, BLOCKED = (
+    "wait", "hold", "drive", "creep", "turn", "lost", "stale", "search", "blocked")
+LINE_BLOCKED = "the robot's line passes through the object"
+PUSHED = "pushed sideways onto the object while holding"
 
 
 @dataclass(frozen=True)
@@ -51,6 +61,13 @@ class ControlConfig:
     fit_frames: int = 6
     steer_gain: float = 25.0  # permille per cm of sideways drift
     steer_damping: float = 60.0  # permille per cm/s of sideways drift rate
+    trim_gain: float = 0.004  # learnt wheel trim, fraction of duty per cm of drift per second
+    max_trim: float = 0.25
+    half_width_m: float = 0.08  # the robot's body, centre to side
+    clearance_m: float = 0.15  # the lane's distance from the object's side: half the body,
+    # and room for the lateral hold error and a sideways drift while holding
+    block_m: float = 0.15  # within this depth of the object, the body must be clear of it
+    block_margin_m: float = 0.02  # by this much (the object's edge is measured to a pixel or two)
     mode: str = "turn"  # or "reverse"
     turn_duty: int = 400
     turn_timeout_s: float = 8.0
@@ -95,7 +112,11 @@ class Controller:
         self.seen = False
         self.missing = 0
         self.floor = config.min_duty
-        self.lateral_ref: float | None = None
+        self.lateral_ref: float | None = None  # the lane the robot holds (m)
+        self.keep_out: tuple[float, float] | None = None  # the object's lateral extent (m)
+        self.trim = 0.0  # fraction of duty added to the right wheel, taken from the left
+        self.fault = ""  # why the robot must stay stopped (the run ends), "" if none
+        self._last_t: float | None = None
         self.history: list[Observation] = []  # valid observations since the last turn
         self._turn: dict | None = None
         self._search_until: float | None = None
@@ -125,7 +146,29 @@ class Controller:
 
     # ------------------------------------------------------------------------- update
 
+    def lane(self) -> float | None:
+        """The lateral position to hold: the first seen, moved clear of the object."""
+        x = self.lateral_ref
+        if x is None or self.keep_out is None:
+            return x
+        x0, x1 = self.keep_out
+        lo, hi = x0 - self.cfg.clearance_m, x1 + self.cfg.clearance_m
+        if lo < x < hi:
+            return lo if x - lo < hi - x else hi
+        return x
+
+    def overlaps(self, lateral: float | None, margin: float = 0.0) -> bool:
+        """Whether the robot's body at this lateral position comes within margin of the
+        object's extent."""
+        if lateral is None or self.keep_out is None:
+            return False
+        x0, x1 = self.keep_out
+        reach = self.cfg.half_width_m + margin
+        return x0 - reach < lateral < x1 + reach
+
     def update(self, obs: Observation) -> Command:
+        if self.fault:
+            return self._stop(BLOCKED, None)
         if self._turn is not None:
             return self._turning(obs)
         if obs.depth_m is None:
@@ -156,6 +199,11 @@ class Controller:
         z, zdot, xdot = self.fit() or (obs.depth_m or 0.0, 0.0, 0.0)
         e = z - self.target_m
         away = e < 0
+        dt = obs.t - self._last_t if self._last_t is not None else 0.0
+        self._last_t = obs.t
+        if abs(e) < cfg.block_m and self.overlaps(obs.lateral_m, cfg.block_margin_m):
+            self.fault = PUSHED if self.phase == HOLD else LINE_BLOCKED
+            return self._stop(BLOCKED, e)
         if self.phase == HOLD and abs(e) <= cfg.tolerance_m:
             return self._stop(HOLD, e)
         moving_in = self.phase in (DRIVE, CREEP)
@@ -174,15 +222,30 @@ class Controller:
         duty = self.floor if creeping else min(cfg.max_duty, int(self.floor + gain * abs(e)))
         duty = duty if forward else -duty
         steer = 0.0
-        if obs.lateral_m is not None and self.lateral_ref is not None:
+        lane = self.lane()
+        if obs.lateral_m is not None and lane is not None:
             # x' = v sin(theta): to cancel a drift to the right, turn so that v cos(theta) * dtheta
             # is negative; v cos(theta) is positive exactly when moving away from the camera
             s = 1.0 if away else -1.0
-            drift = obs.lateral_m - self.lateral_ref
-            steer = s * (cfg.steer_gain * 100 * drift + cfg.steer_damping * 100 * xdot) / 2
-            steer = max(-abs(duty) * 0.6, min(abs(duty) * 0.6, steer))
+            drift = obs.lateral_m - lane
+            moving = abs(zdot) > 0.02  # the heading shows only in motion
+            if moving and self.phase == DRIVE and 0 < dt < 0.5:
+                # the wheel that lags stays the same one whichever way the robot faces
+                w = s if forward else -s
+                self.trim = max(-cfg.max_trim, min(cfg.max_trim, self.trim + w * cfg.trim_gain
+                                                   * 100 * max(-0.05, min(0.05, drift)) * dt))
+            pd = s * (cfg.steer_gain * 100 * drift + cfg.steer_damping * 100 * xdot) / 2
+            # creeping (the last few cm) the drift rate is mostly a sideways push, not heading:
+            # steering against it turns the robot off the card's visible range and, near the
+            # dead zone, spins it in place; only the wheels' trim acts there
+            steer = (0.0 if creeping else max(-abs(duty) / 2, min(abs(duty) / 2, pd)))
+            steer += self.trim * duty
         self.phase = CREEP if creeping else DRIVE
-        return Command(int(round(duty - steer)), int(round(duty + steer)), self.phase, e)
+        left, right = duty - steer, duty + steer
+        lift = self.floor - min(abs(left), abs(right))  # no wheel below the least duty that moves
+        if lift > 0:
+            left, right = left + math.copysign(lift, duty), right + math.copysign(lift, duty)
+        return Command(int(round(left)), int(round(right)), self.phase, e)
 
     # --------------------------------------------------------------------------- turn
 
@@ -211,7 +274,11 @@ class Controller:
             turn["last_seen"] = (obs.t, obs.aspect)
         elif not seen and turn["lost_t"] is None and not obs.invalid:
             turn["lost_t"], turn["lost_aspect"] = turn["last_seen"]
-        elif seen and turn["lost_t"] is not None and obs.t - turn["lost_t"] >= cfg.min_gap_s:
+        elif seen and turn["lost_t"] is not None and obs.t - turn["lost_t"] < cfg.min_gap_s:
+            # back within min_gap_s: a missed detection, not the card's back; forget the loss,
+            # or a later sighting (min_gap_s after it) would end the turn there
+            turn["lost_t"], turn["last_seen"] = None, (obs.t, obs.aspect)
+        elif seen and turn["lost_t"] is not None:
             a_lost = min(1.0, turn["lost_aspect"])
             a_now = min(1.0, obs.aspect)
             swept = math.pi - math.acos(a_lost) - math.acos(a_now)

@@ -118,6 +118,7 @@ class Servo:
         self._prev: tuple[float, float, float] | None = None  # t_right, right u, skew-free d
         self._latency_floor: float | None = None
         self._last_capture: float | None = None
+        self._width = 0
 
     def _frame(self) -> StereoFrame:
         frame = self.source.read()
@@ -159,7 +160,18 @@ class Servo:
         self.target, self.floor = reference_target(disps, self.min_area)
         self._target_history = [self.target.disparity] * 2
         self.controller = Controller(self.geometry.depth_m(self.target.disparity), self.control)
+        self._width = w
+        self.controller.keep_out = self._extent(self.target)
         return self.target
+
+    def _extent(self, target: Target) -> tuple[float, float]:
+        """The object's lateral extent (m) at its depth, from its image region; a side cut by
+        the image's edge reaches on beyond it."""
+        g, d = self.geometry, target.disparity
+        bx, _, bw, _ = target.bbox
+        x0 = -math.inf if bx <= 0 else g.baseline_m * (bx - g.cx) / d
+        x1 = math.inf if bx + bw >= self._width else g.baseline_m * (bx + bw - g.cx) / d
+        return x0, x1
 
     @property
     def target_m(self) -> float:
@@ -253,8 +265,15 @@ class Servo:
             median = float(np.median(self._target_history[-3:]))
             self.target = Target(median, found.area, found.bbox, found.spread)
         else:
-            still = float(np.median(there)) > old.disparity - max(1.0, 0.1 * old.disparity)
-            kind = "appeared" if still else "vanished"
+            # gone means seen through: most of the object's area now shows what lies behind
+            # it; a region hidden by something nearer (or masked as the robot) is not gone
+            behind = int(np.count_nonzero(there < old.disparity - max(1.0, 0.1 * old.disparity)))
+            if behind >= old.area // 2:
+                kind = "vanished"
+            elif found is not None and found.disparity > old.disparity:
+                kind = "appeared"
+            else:
+                return  # hidden, or nothing clear: nothing to learn
             n = self._doubt[0] + 1 if self._doubt[1] == kind else 1
             self._doubt = (n, kind)
             if n < 2:
@@ -267,6 +286,7 @@ class Servo:
                               f"retargeting")
             self.target = found
             self._target_history = [found.disparity] * 2
+            self.controller.keep_out = self._extent(found)
         self.controller.target_m = self.geometry.depth_m(self.target.disparity)
 
     # ---------------------------------------------------------------------- noise phase
@@ -326,10 +346,13 @@ class Servo:
         if due:
             self._remeasure_t = frame.t_left
         if due or self._strips.busy:  # a band of the re-measure's map each frame, then the map
-            if self.controller.phase == "turn":
+            # the robot must be left out of the scene: with its marker unseen this frame, the
+            # last place it was seen (it stops when the marker is lost); never seen: skip
+            robot_at = pair or self.last_pair
+            if self.controller.phase == "turn" or robot_at is None:
                 self._strips.reset()
             else:
-                hide = None if pair is None else self._robot_region(pair, frame.left.shape)
+                hide = self._robot_region(robot_at, frame.left.shape)
                 whole = self._strips.add(frame.left, frame.right, hide)
                 if whole is not None:
                     self._remeasure(whole)
@@ -345,6 +368,8 @@ class Servo:
             aspect = pair.left.aspect if pair is not None else 1.0
             cmd = self.controller.update(Observation(frame.t_left, depth, lateral, aspect,
                                                      invalid))
+            if self.controller.fault:  # it cannot go on: the run ends here
+                self.stop_reason = stop_reason = self.controller.fault
         t_send = time.perf_counter()
         self._send(cmd)
         rtt_ms = (time.perf_counter() - t_send) * 1000

@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from host.camera.source import CameraError
+from host.errors import HostError
 from host.files import write_text_atomic
 from host.link.client import LinkError
 from host.servo.controller import ControlConfig
@@ -184,13 +185,20 @@ def summary(trials: list[Trial]) -> dict:
 
 def run_trials(n: int, seed: int, size: tuple[int, int], params: MatcherParams,
                json_path: Path | None = None, workers: int = 2, nominal: bool = False,
-               out=sys.stdout) -> int:
-    jobs = [(seed, i, size, params, nominal) for i in range(n)]
+               out=sys.stdout, indices: list[int] | None = None) -> int:
+    """Runs trials 0..n-1 (or only those of `indices`: trial i is the same whatever else
+    runs), prints each and the summary, optionally writes them as JSON."""
+    if indices and max(indices) >= n:
+        raise HostError(f"--trial-index {max(indices)} is not among the {n} trials")
+    jobs = [(seed, i, size, params, nominal) for i in (sorted(set(indices)) if indices
+                                                       else range(n))]
     trials: list[Trial] = []
     world = "nominal" if nominal else "faulty"
-    print(f"{n} trials of the {world} world at {size[0]}x{size[1]}, seed {seed}", file=out)
+    print(f"{len(jobs)} of {n} trials of the {world} world at {size[0]}x{size[1]}, seed {seed}"
+          if indices else f"{n} trials of the {world} world at {size[0]}x{size[1]}, seed {seed}",
+          file=out)
     ctx = multiprocessing.get_context("spawn")
-    with ctx.Pool(max(1, workers)) as pool:
+    with ctx.Pool(max(1, min(workers, len(jobs)))) as pool:
         for t in pool.imap(run_trial, jobs):
             trials.append(t)
             print(f"  {t.index:3d}  start {t.start_m:4.2f} m  target {t.target_m:4.2f} m  "

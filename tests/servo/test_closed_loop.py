@@ -30,3 +30,17 @@ def test_reverse_mode_comes_back_without_turning() -> None:
         assert abs(sim.world.robot.z_m - sim.world.nearest_box().z_m) <= 0.03
         assert not any(r.phase == "turn" for r in sim.servo.rows)
         assert min(r.left for r in sim.servo.rows) < 0
+
+
+def test_a_start_in_line_with_the_objects_side_ends_beside_it_not_in_it() -> None:
+    """Started 11 cm left of the camera's axis, the robot's straight line to the depth of the
+    nearest box (its right side at -0.18 m) puts its 16 cm body 1 cm into the box: the servo
+    sees the box's extent in its image region, steers to a lane clear of it and holds beside
+    it (on main it held with the body inside the box)."""
+    with simulation(0.7, start_x_m=-0.11) as sim:
+        sim.run(15.0)
+        box = sim.world.nearest_box()
+        r = sim.world.robot
+        assert sim.servo.outcome() == ("held", "")
+        assert abs(r.z_m - box.z_m) <= 0.02
+        assert r.x_m - r.body_width_m / 2 > box.x1_m + 0.02

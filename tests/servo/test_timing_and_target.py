@@ -70,3 +70,21 @@ def test_a_pair_captured_too_far_apart_is_not_used() -> None:
         sim.source.read = skewed
         row = sim.servo.step()
         assert row.reason == "skew" and (row.left, row.right) == (0, 0)
+
+
+def test_a_hidden_marker_does_not_make_the_robot_the_target() -> None:
+    """Someone hides the card while the robot stands 15 cm before the box: the re-measure must
+    still leave the robot out (where it was last seen), so the robot's own body is neither a
+    nearer object to retarget to nor a sign that the box vanished (trial 85 of seed 1 stopped
+    with "target vanished" so); shown again, the card leads the robot on to the box."""
+    with simulation(Setup((320, 240), 0.8)) as sim:
+        while sim.world.robot.z_m < 1.05 and sim.source.t < 10:
+            sim.step()
+        sim.world.robot.marker_hidden = True
+        sim.run(sim.source.t + 2.5, settle=None)  # two re-measures or more, robot stopped
+        assert sim.servo.stop_reason == "" and not sim.servo.notes
+        assert sim.servo.target_m == pytest.approx(1.2, abs=0.02)
+        sim.world.robot.marker_hidden = False
+        sim.run(sim.source.t + 8.0)
+        assert sim.servo.outcome() == ("held", "")
+        assert abs(sim.world.robot.z_m - 1.2) <= 0.02

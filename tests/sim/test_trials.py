@@ -41,3 +41,22 @@ def test_summary_counts_outcomes_and_percentiles() -> None:
     assert s["error_cm_max"] == pytest.approx(0.7)
     assert s["error_cm_p50"] == pytest.approx(0.35)
     assert s["reasons"] == {"stopped: target vanished": 1, "unsafe: hit the object": 1}
+
+
+def test_a_trial_index_beyond_the_trials_is_refused() -> None:
+    from host.errors import HostError
+    from host.sim.trials import run_trials
+    from host.stereo.params import MatcherParams
+
+    with pytest.raises(HostError, match="--trial-index 5 is not among the 5 trials"):
+        run_trials(5, 1, (320, 240), MatcherParams(), indices=[5])
+
+
+def test_trial_setups_do_not_depend_on_which_others_run() -> None:
+    """--trial-index I reproduces trial I of a full run: its world comes from (seed, I) only."""
+    from host.sim.trials import trial_setup
+    from host.stereo.params import MatcherParams
+
+    a = trial_setup(1, 51, (320, 240), MatcherParams())
+    trial_setup(1, 50, (320, 240), MatcherParams())
+    assert trial_setup(1, 51, (320, 240), MatcherParams()) == a

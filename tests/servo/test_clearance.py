@@ -1,0 +1,112 @@
+"""Lateral safety of the control law, against the small plant of test_controller: a robot whose
+line runs into the object's side moves to a lane clear of it and holds beside the object; one
+that cannot be cleared stops with its reason; a missed detection far away does not end the
+turn early."""
+
+from __future__ import annotations
+
+from host.servo.controller import LINE_BLOCKED, PUSHED, ControlConfig, Controller, Observation
+from tests.servo.test_controller import Plant
+
+BOX = (-0.50, -0.18)  # the object's lateral extent, m (the default scene's nearest box)
+
+
+def drive(plant: Plant, ctl: Controller, seconds: float = 30.0) -> None:
+    while plant.t < seconds:
+        cmd = ctl.update(plant.observe())
+        plant.run(33, (cmd.left, cmd.right))
+        if ctl.fault or (ctl.phase == "hold" and plant.t > 3
+                         and abs(plant.vl) + abs(plant.vr) < 1e-4):
+            return
+
+
+def test_a_line_through_the_objects_side_is_moved_clear_and_held_beside_it() -> None:
+    """Started 12 cm left of centre, the robot's body (8 cm each side) would end 6 cm inside
+    the box's edge at -0.18 m (trial 51 of seed 1 hit the object so); it steers to a lane
+    clearance_m from the edge and holds there, with a weaker right motor too."""
+    for gains in ((1.0, 1.0), (1.0, 0.85)):
+        plant = Plant(0.7, gains=gains)
+        plant.x = -0.12
+        ctl = Controller(1.2, ControlConfig())
+        ctl.keep_out = BOX
+        drive(plant, ctl)
+        assert ctl.phase == "hold" and abs(plant.z - 1.2) < 0.01
+        assert ctl.lane() == BOX[1] + ctl.cfg.clearance_m
+        assert plant.x - ctl.cfg.half_width_m > BOX[1] + 0.03  # the body is clear of the box
+
+
+def test_a_lane_already_clear_is_kept() -> None:
+    ctl = Controller(1.2, ControlConfig())
+    ctl.keep_out = BOX
+    ctl.update(Observation(0.0, 0.8, 0.05))
+    assert ctl.lane() == 0.05
+
+
+def test_a_body_that_overlaps_the_object_near_its_depth_stops_with_the_reason() -> None:
+    """Within block_m of the object's depth with its body over the object's extent, the robot
+    stops and stays stopped, naming why."""
+    ctl = Controller(1.2, ControlConfig())
+    ctl.keep_out = BOX
+    cmd = ctl.update(Observation(0.0, 1.1, -0.15))
+    assert cmd.is_stop and ctl.fault == LINE_BLOCKED
+    assert ctl.update(Observation(0.03, 1.1, 0.2)).is_stop  # it does not drive on
+    # far from the object's depth the same line is not yet a reason to stop
+    far = Controller(1.2, ControlConfig())
+    far.keep_out = BOX
+    assert not far.update(Observation(0.0, 0.6, -0.15)).is_stop and not far.fault
+
+
+def test_a_holding_robot_pushed_onto_the_object_stops_the_run() -> None:
+    """Standing still it cannot move sideways: pushed toward the object's side it ends the run
+    with the reason rather than report a hold inside the object (trial 27 of seed 1)."""
+    ctl = Controller(1.2, ControlConfig())
+    ctl.keep_out = BOX
+    t = 0.0
+    for _ in range(10):
+        t += 0.033
+        ctl.update(Observation(t, 1.2, -0.05))
+    assert ctl.phase == "hold"
+    x = -0.05
+    while not ctl.fault and x > -0.2:
+        t, x = t + 0.033, x - 0.003
+        ctl.update(Observation(t, 1.2, x))
+    assert ctl.fault == PUSHED and x > BOX[1] + ctl.cfg.half_width_m
+
+
+def test_a_missed_detection_is_forgotten_and_does_not_end_the_turn_later() -> None:
+    """Far away the small card is missed for two frames just after the turn starts: that loss
+    must be forgotten, else the card seen 0.3 s after it counts as its other side coming round
+    (trial 63 of seed 1 ended its turn at 27 degrees so, and lost the marker for good)."""
+    ctl = Controller(1.4, ControlConfig())
+    t = 0.0
+    assert ctl.update(Observation(t, 2.9, 0.0, 1.0)).phase == "turn"
+    for _ in range(2):
+        t += 0.033
+        assert ctl.update(Observation(t, None)).phase == "turn"
+    for _ in range(10):  # seen again, still facing the camera, for a third of a second
+        t += 0.033
+        assert ctl.update(Observation(t, 2.9, 0.0, 0.87)).phase == "turn"
+    assert ctl.facing_away
+    # the real edge-on loss (far away at 30 degrees) and return at 150 degrees end it
+    for _ in range(45):
+        t += 0.033
+        ctl.update(Observation(t, None))
+    for _ in range(10):
+        t += 0.033
+        cmd = ctl.update(Observation(t, 2.9, 0.0, 0.87))
+    assert cmd.phase != "turn" and not ctl.facing_away
+
+
+def test_creeping_does_not_steer_against_a_sideways_push() -> None:
+    """In the last few cm a sideways push (1 cm/s here) dominates the drift rate; steering
+    against it turned the robot 40 degrees off the card's visible range and, near the dead
+    zone, spun it on one wheel (trials 2 and 53 of seed 1): creeping, both wheels get about the
+    same duty and neither gets less than the least duty that moves the robot."""
+    ctl = Controller(1.2, ControlConfig())
+    t, z, x = 0.0, 1.17, 0.0
+    for _ in range(20):
+        cmd = ctl.update(Observation(t, z, x))
+        t, z, x = t + 0.033, z + 0.0005, x - 0.00033
+    assert cmd.phase == "creep"
+    assert abs(cmd.left - cmd.right) <= 0.1 * ctl.floor
+    assert min(cmd.left, cmd.right) >= ctl.floor
