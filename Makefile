@@ -55,6 +55,7 @@ bench: venv
 	$(BIN)/python bench/firmware.py
 	$(BIN)/python bench/link.py
 	$(BIN)/python bench/servo.py
+	$(BIN)/python bench/view.py
 	$(MAKE) mutants
 
 # firmware mutation testing (firmware/atmega328/mutants.toml): every mutant must be killed; it
