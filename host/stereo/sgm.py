@@ -336,9 +336,15 @@ OVERLAP = 24  # rows the lower stripe of the 5-path pass starts above its first 
 def _down(cl, crrev, vol, S, P, M, crow, tot, y0, y1, warm, p1, p2, dmin, uniqueness, fit,
           want_right, disp_l, disp_r, acc, acc16, sh, keep):
     """The 5-path pass over rows y0 .. y1 - 1, top to bottom: paths 1-3 from the top-left,
-    top and top-right and 0 from the left at x = t, 4 from the right at x = w - 1 - t, then
-    the row's sum is decided (with keep, stored in S). The three paths from above start warm
-    rows above y0 (those rows are not decided).
+    top and top-right and 0 from the left in one sweep along the row (x rising), which leaves
+    their sum in tot; then 4 from the right in a sweep back, which adds it and takes each
+    pixel's minimum; then the row is decided (with keep, stored in S). The three paths from
+    above start warm rows above y0 (those rows are not decided).
+
+    Only the paths from above keep whole rows (P[., 1 .. 3]); the two along the row keep just
+    the previous pixel, in H (2 pixel parities, nd + 2), so no row of them is written and read
+    back. Each sweep steps a chain along the row (each step waits for the one before) beside
+    independent work (the three paths from above; the sums), which the processor overlaps.
     """
     h, w = cl.shape
     nd = crow.shape[1]
@@ -346,58 +352,57 @@ def _down(cl, crrev, vol, S, P, M, crow, tot, y0, y1, warm, p1, p2, dmin, unique
     jj = np.arange(nd + 1).astype(np.uint32)
     fb = np.empty((4, w), dtype=np.float32)
     mins = np.empty(w, dtype=np.uint16)
+    H = np.empty((2, nd + 2), dtype=np.uint16)
+    H[:, 0] = PAD
+    H[:, nd + 1] = PAD
     for i in range(y1 - y0 + warm):
         y = y0 - warm + i
         decided = i >= warm
         _cost_row(cl, crrev, vol, y, dmin, crow)
         b = i % 2
         a = 1 - b
-        for t in range(w):
-            x = t
-            c = crow[x]
-            if i == 0 or x == 0:
-                M[b, 1, x] = _start(P[b, 1, x], c, nd)
-            else:
-                M[b, 1, x] = _step(P[a, 1, x - 1], M[a, 1, x - 1], P[b, 1, x], c, p1, p2, nd)
-            if i == 0:
-                M[b, 2, x] = _start(P[b, 2, x], c, nd)
-            else:
-                M[b, 2, x] = _step(P[a, 2, x], M[a, 2, x], P[b, 2, x], c, p1, p2, nd)
-            if i == 0 or x == w - 1:
-                M[b, 3, x] = _start(P[b, 3, x], c, nd)
-            else:
-                M[b, 3, x] = _step(P[a, 3, x + 1], M[a, 3, x + 1], P[b, 3, x], c, p1, p2, nd)
-            if not decided:
-                continue
-            # the two paths along the row are chains (each step waits for the one before):
-            # stepping both here lets the processor overlap them with the three above
-            if x == 0:
-                M[b, 0, x] = _start(P[b, 0, x], c, nd)
-            else:
-                M[b, 0, x] = _step(P[b, 0, x - 1], M[b, 0, x - 1], P[b, 0, x], c, p1, p2, nd)
-            x = w - 1 - t
-            c = crow[x]
-            if x == w - 1:
-                M[b, 4, x] = _start(P[b, 4, x], c, nd)
-            else:
-                M[b, 4, x] = _step(P[b, 4, x + 1], M[b, 4, x + 1], P[b, 4, x], c, p1, p2, nd)
-        if not decided:
-            continue
+        m0 = np.uint16(0)
         for x in range(w):
-            o = tot[x]
-            h0 = P[b, 0, x]
+            c = crow[x]
             d1 = P[b, 1, x]
             v2 = P[b, 2, x]
             d3 = P[b, 3, x]
-            h4 = P[b, 4, x]
+            if i == 0 or x == 0:
+                M[b, 1, x] = _start(d1, c, nd)
+            else:
+                M[b, 1, x] = _step(P[a, 1, x - 1], M[a, 1, x - 1], d1, c, p1, p2, nd)
+            if i == 0:
+                M[b, 2, x] = _start(v2, c, nd)
+            else:
+                M[b, 2, x] = _step(P[a, 2, x], M[a, 2, x], v2, c, p1, p2, nd)
+            if i == 0 or x == w - 1:
+                M[b, 3, x] = _start(d3, c, nd)
+            else:
+                M[b, 3, x] = _step(P[a, 3, x + 1], M[a, 3, x + 1], d3, c, p1, p2, nd)
+            if not decided:
+                continue
+            h0 = H[x % 2]
+            m0 = _start(h0, c, nd) if x == 0 else _step(H[1 - x % 2], m0, h0, c, p1, p2, nd)
+            o = tot[x]
+            for j in range(nd):
+                o[j] = h0[j + 1] + d1[j + 1] + v2[j + 1] + d3[j + 1]
+        if not decided:
+            continue
+        m4 = np.uint16(0)
+        for t in range(w):
+            x = w - 1 - t
+            c = crow[x]
+            h4 = H[t % 2]
+            m4 = _start(h4, c, nd) if t == 0 else _step(H[1 - t % 2], m4, h4, c, p1, p2, nd)
+            o = tot[x]
             lo = np.uint16(0xFFFF)
             for j in range(nd):
-                v = np.uint16(h0[j + 1] + d1[j + 1] + v2[j + 1] + d3[j + 1] + h4[j + 1])
+                v = np.uint16(o[j] + h4[j + 1])
                 o[j] = v
                 lo = min(lo, v)
             mins[x] = lo
         _decide_row(tot, mins, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc,
-                        acc16, sh, idx, jj, fb)
+                    acc16, sh, idx, jj, fb)
         if keep:
             S[y] = tot
 

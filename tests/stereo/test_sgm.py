@@ -83,9 +83,10 @@ def _match(cost: np.ndarray, p1: int, p2: int, paths: int, dmin: int = 0, fit: i
 
 
 @pytest.mark.parametrize(("paths", "dirs"), [(8, EIGHT), (5, FIVE), (4, FOUR)])
-@pytest.mark.parametrize("shape", [(6, 7, 5), (9, 5, 8)])
+@pytest.mark.parametrize("shape", [(6, 7, 5), (9, 5, 8), (5, 1, 4), (4, 2, 6)])
 def test_path_aggregation_equals_the_plain_recurrence(paths, dirs, shape) -> None:
-    # odd and even row counts: the two directions meet in the middle row
+    # odd and even row counts: the two directions meet in the middle row; one and two columns:
+    # the paths along the row start (and, with 5 paths, hand over their last pixel) at once
     rng = np.random.default_rng(4)
     cost = rng.integers(0, 63, shape).astype(np.uint16)
     _, _, total = _match(cost, 7, 30, paths)
