@@ -1,4 +1,4 @@
-"""Own block matcher: SAD / SSD / zero-mean NCC with running sums, WTA and sub-pixel parabola.
+"""Own block matcher: SAD / SSD / zero-mean NCC with running sums, WTA and sub-pixel fit.
 
 Conventions: the left image is the reference; a left pixel x matches right pixel x - d; the output
 is float32 disparity in pixels with NaN where the matcher gives no disparity. Window sums are kept
@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit, prange
+
+from host.stereo.subpixel import FIT_NONE, fit_offset
 
 COST_SAD = 0
 COST_SSD = 1
@@ -119,22 +121,17 @@ def _argmin(cost, kmin, nd):
 
 
 @njit(cache=True, fastmath=True, inline="always")
-def _refine(cost, best, kmin, nd, uniqueness):
-    """Uniqueness test and parabola offset (in k units) around the best candidate."""
+def _decide(cost, best, kmin, nd, uniqueness, fit):
+    """Uniqueness test and sub-pixel offset (k units) of the winner; ok False = rejected."""
     c0 = np.float32(cost[best])
     if uniqueness > 0.0:
         bound = c0 * (1.0 + uniqueness / 100.0)
         for k in range(kmin, nd):
             if (k < best - 1 or k > best + 1) and cost[k] <= bound:
                 return 0.0, False
-    off = 0.0
-    if best > kmin and best < nd - 1:
-        cm = np.float32(cost[best - 1])
-        cp = np.float32(cost[best + 1])
-        den = cm - 2.0 * c0 + cp
-        if den > 0.0:
-            off = 0.5 * (cm - cp) / den
-    return off, True
+    if fit == FIT_NONE or best <= kmin or best >= nd - 1:
+        return 0.0, True
+    return fit_offset(np.float32(cost[best - 1]), c0, np.float32(cost[best + 1]), fit), True
 
 
 @njit(cache=True)
@@ -171,12 +168,13 @@ def padded_pair(left, right, dmin, nd, half, clip):
 
 
 @njit(cache=True, parallel=True, fastmath=True)
-def match_rows(left, right, dmin, nd, half, kind, uniqueness, subpixel, want_right, clip,
+def match_rows(left, right, dmin, nd, half, kind, uniqueness, fit, want_right, clip,
                sum_l, sq_l, sum_r, sq_r):
     """Disparity maps (left, right) for uint8 images shaped (channels, rows, cols).
 
     The cost of a window is summed over channels (NCC takes one channel). clip: windows at the
-    image edge are cropped to the image instead of making the pixel invalid. dmin >= 0.
+    image edge are cropped to the image instead of making the pixel invalid. dmin >= 0. fit: the
+    sub-pixel fit (FIT_NONE, FIT_PARABOLA or FIT_EQUIANGULAR).
     """
     nch, h, w = left.shape
     disp_l, disp_r, left_p, right_p, pad, rows, x_start, x_end = padded_pair(left, right, dmin,
@@ -212,12 +210,12 @@ def match_rows(left, right, dmin, nd, half, kind, uniqueness, subpixel, want_rig
                 kmin = max(0, nd - 1 - dmax)
                 if kmin == 0 and shift >= 0:
                     k = _slide_window_argmin(win, enter, leave, shift)
-                    off, ok = _refine(win, k, 0, nd, uniqueness)
+                    off, ok = _decide(win, k, 0, nd, uniqueness, fit)
                     if want_right:
                         rowcost[x, :] = win
                     if ok:
                         d = dmin + nd - 1 - k
-                        disp_l[yi, x] = d - off if subpixel else d
+                        disp_l[yi, x] = d - off
                     continue
                 _slide_window(win, enter, leave)
                 if dmax < 0:
@@ -226,24 +224,24 @@ def match_rows(left, right, dmin, nd, half, kind, uniqueness, subpixel, want_rig
                 if kind == COST_NCC:
                     _ncc_row(win, yi, x, half, h, w, dmin, nd, sum_l, sq_l, sum_r, sq_r, fcost)
                     k = _argmin(fcost, kmin, nd)
-                    off, ok = _refine(fcost, k, kmin, nd, uniqueness)
+                    off, ok = _decide(fcost, k, kmin, nd, uniqueness, fit)
                 else:
                     k = _argmin(win, kmin, nd)
-                    off, ok = _refine(win, k, kmin, nd, uniqueness)
+                    off, ok = _decide(win, k, kmin, nd, uniqueness, fit)
                 if want_right:
                     for j in range(nd):
                         rowcost[x, j] = np.inf if j < kmin else (
                             fcost[j] if kind == COST_NCC else win[j])
                 if ok:
                     d = dmin + nd - 1 - k
-                    disp_l[yi, x] = d - off if subpixel else d
+                    disp_l[yi, x] = d - off
             if want_right:
-                _right_row(rowcost, disp_r, yi, w, x_start, x_end, dmin, nd, subpixel)
+                _right_row(rowcost, disp_r, yi, w, x_start, x_end, dmin, nd, fit)
     return disp_l, disp_r
 
 
 @njit(cache=True, fastmath=True)
-def _right_row(rowcost, disp_r, y, w, x_start, x_end, dmin, nd, subpixel):
+def _right_row(rowcost, disp_r, y, w, x_start, x_end, dmin, nd, fit):
     # cost of right pixel xr at disparity d is the left cost at x = xr + d
     col = np.empty(nd, dtype=np.float32)
     for xr in range(w):
@@ -258,7 +256,7 @@ def _right_row(rowcost, disp_r, y, w, x_start, x_end, dmin, nd, subpixel):
         if not any_valid:
             continue
         k = _argmin(col, 0, nd)
-        off, _ = _refine(col, k, 0, nd, 0.0)
+        off, _ = _decide(col, k, 0, nd, 0.0, fit)
         if col[k] < np.inf:
             d = dmin + nd - 1 - k
-            disp_r[y, xr] = d - off if subpixel else d
+            disp_r[y, xr] = d - off

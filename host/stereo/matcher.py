@@ -75,7 +75,7 @@ def own_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
     want_right = p.lr_check is not None
     disp_l, disp_r = bm.match_rows(pl, pr, p.min_disparity, p.num_disparities,
                                    p.block_size // 2, kind, float(p.uniqueness_ratio),
-                                   p.subpixel, want_right, p.border == "clip",
+                                   subpixel_fit(p), want_right, p.border == "clip",
                                    sl, ql, sr, qr)
     if want_right:
         disp_l = lr_consistency(disp_l, disp_r, float(p.lr_check))

@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from host.stereo.block_matching import _argmin, padded_pair  # first minimum; padded images
+from host.stereo.block_matching import _argmin, _decide, padded_pair
 from host.stereo.subpixel import FIT_NONE, fit_offset
 
 TILE_BYTES = 8192  # column sums updated per tile: well inside a 32 KiB L1 with the pixel rows
@@ -92,20 +92,6 @@ def _slide_min(win, enter, leave, idx):
 def _slide(win, enter, leave):
     for k in range(win.size):
         win[k] = win[k] + enter[k] - leave[k]
-
-
-@njit(cache=True, fastmath=True, inline="always")
-def _decide(win, best, kmin, nd, uniqueness, fit):
-    """Uniqueness test and sub-pixel offset (k units) of the winner; ok False = rejected."""
-    c0 = np.float32(win[best])
-    if uniqueness > 0.0:
-        bound = c0 * (1.0 + uniqueness / 100.0)
-        for k in range(kmin, nd):
-            if (k < best - 1 or k > best + 1) and win[k] <= bound:
-                return 0.0, False
-    if fit == FIT_NONE or best <= kmin or best >= nd - 1:
-        return 0.0, True
-    return fit_offset(np.float32(win[best - 1]), c0, np.float32(win[best + 1]), fit), True
 
 
 @njit(cache=True, fastmath=True, inline="always")

@@ -42,3 +42,20 @@ def test_equiangular_fit_does_not_pull_sad_to_whole_pixels(d: float) -> None:
     toward_integer = np.sign(round(d) - d)
     assert abs(v) < 0.05
     assert p * toward_integer > 0.07
+
+
+@pytest.mark.parametrize("matcher", ["ssd", "ncc"])
+def test_block_matchers_use_the_fit_they_are_given(matcher: str) -> None:
+    # SSD and NCC go through block_matching's kernel: the fit named in the params is the one
+    # applied (equiangular and parabola differ off whole pixels), and none gives whole pixels
+    rng = np.random.default_rng(2)
+    tex = random_texture(rng, 90, 240, sigma=1.2)
+    scene = render_pair([Layer(13.3, tex, margin=40)], 160, 90, noise=0.0)
+    maps = {fit: compute_disparity(scene.left, scene.right, MatcherParams(
+        matcher=matcher, block_size=9, num_disparities=32, border="clip", subpixel_fit=fit))
+        for fit in ("parabola", "equiangular")}
+    whole = compute_disparity(scene.left, scene.right, MatcherParams(
+        matcher=matcher, block_size=9, num_disparities=32, border="clip", subpixel=False))
+    inner = np.s_[10:-10, 30:-10]
+    assert not np.allclose(maps["parabola"][inner], maps["equiangular"][inner], equal_nan=True)
+    assert np.all(np.isnan(whole[inner]) | (whole[inner] == np.round(whole[inner])))
