@@ -36,27 +36,6 @@ def load() -> str:
     return "load {:.2f} {:.2f} {:.2f}".format(*os.getloadavg())
 
 
-def _block(fn, calls: int) -> float:
-    t0 = time.perf_counter()
-    for _ in range(calls):
-        fn()
-    return (time.perf_counter() - t0) * 1000 / calls
-
-
-def side_by_side(own, ref) -> tuple[float, float]:
-    """Median block times (ms per call) of two callables run in alternating blocks."""
-    own()
-    ref()
-    t0 = time.perf_counter()
-    ref()
-    calls = max(2, int(CALL_MS / max(1.0, (time.perf_counter() - t0) * 1000)))
-    a, b = [], []
-    for _ in range(BLOCKS):
-        a.append(_block(own, calls))
-        b.append(_block(ref, calls))
-    return statistics.median(a), statistics.median(b)
-
-
 def _cpu_block(fn, calls: int) -> tuple[float, float]:
     w0, c0 = time.perf_counter(), time.process_time()
     for _ in range(calls):
@@ -65,9 +44,9 @@ def _cpu_block(fn, calls: int) -> tuple[float, float]:
 
 
 def side_by_side_cpu(own, ref) -> tuple[float, float, float, float]:
-    """Like side_by_side, also with the process CPU time per call: (wall own, wall ref, CPU
-    own, CPU ref), medians over blocks. On one thread the CPU time is what the call would take
-    on an idle core, so its ratio holds up when other work shares the machine."""
+    """Two callables run in alternating blocks: (wall own, wall ref, CPU own, CPU ref), ms per
+    call, medians over blocks (CPU: the process time). On one thread the CPU time is what the
+    call would take on an idle core, so its ratio holds up when other work shares the machine."""
     own()
     ref()
     t0 = time.perf_counter()
@@ -79,6 +58,11 @@ def side_by_side_cpu(own, ref) -> tuple[float, float, float, float]:
         b.append(_cpu_block(ref, calls))
     med = [statistics.median(v[k] for v in x) for k in (0, 1) for x in (a, b)]
     return med[0], med[1], med[2], med[3]
+
+
+def side_by_side(own, ref) -> tuple[float, float]:
+    """Median block times (ms per call) of two callables run in alternating blocks."""
+    return side_by_side_cpu(own, ref)[:2]
 
 
 def set_threads(n: int) -> None:
