@@ -127,6 +127,10 @@ def run(args: argparse.Namespace) -> int:
         check_output(args.plot, "png", "--plot")
     if args.min_duty > args.max_duty:
         raise HostError(f"--min-duty {args.min_duty} exceeds --max-duty {args.max_duty}")
+    trial_only = [o for o, v in (("--json", args.json), ("--nominal", args.nominal),
+                                 ("--trial-index", args.trial_index)) if v]
+    if trial_only and not args.trials:
+        raise HostError(f"{trial_only[0]} goes with --trials N: without it nothing reads it")
     if args.sim or args.camera == "sim":
         if args.port not in (None, "emulator"):
             raise HostError("--camera sim needs --port emulator (the simulated robot)")
