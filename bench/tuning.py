@@ -38,7 +38,7 @@ from host.tuning.disparity_range import RangePolicy, apply_range
 from host.tuning.ground_truth import GroundTruthScore
 from host.tuning.learners import tune
 from host.tuning.objective import Objective, SceneTable
-from host.tuning.self_supervised import TERMS, Weights, score_of, terms_of_maps
+from host.tuning.self_supervised import TERMS, Pair, Weights, score_of
 from host.tuning.spaces import Space, make_space
 
 BASE = MatcherParams(border="clip")
@@ -62,6 +62,10 @@ class TermsAndTruth:
 
     def __init__(self, scenes: list[Scene], ranges, maps_dir: Path | None = None) -> None:
         self.scenes, self.ranges, self.maps_dir = scenes, ranges, maps_dir
+        self._pairs: dict[str, Pair] = {}  # census of each scene, made once per process
+
+    def __getstate__(self) -> dict:
+        return self.__dict__ | {"_pairs": {}}
 
     def disparity(self, s: Scene, p: MatcherParams) -> np.ndarray:
         path = None
@@ -82,7 +86,9 @@ class TermsAndTruth:
         out: list[float] = []
         for s, r in zip(self.scenes, self.ranges):
             disp_l = self.disparity(s, apply_range(params, r))
-            t = terms_of_maps(s.left, s.right, disp_l)
+            if s.name not in self._pairs:
+                self._pairs[s.name] = Pair(s.left, s.right)
+            t = self._pairs[s.name].terms(disp_l)
             assert s.gt is not None
             out += [t[k] for k in TERMS] + [evaluate(disp_l, s.gt, s.masks.get("nonocc")).bad]
         return out

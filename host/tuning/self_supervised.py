@@ -143,6 +143,23 @@ def _terms(disp_l: np.ndarray, cl: np.ndarray, cr: np.ndarray, grey: np.ndarray,
     return (recon / max(visible, 1), holes / n, hidden / n, invalid / n, rough / max(pairs, 1))
 
 
+class Pair:
+    """A rectified pair with what every evaluation on it shares: grey images and census."""
+
+    def __init__(self, left: np.ndarray, right: np.ndarray) -> None:
+        self.left, self.right = left, right
+        self.grey = to_grey(left)
+        self.census_left = census(self.grey, CENSUS_RADIUS)
+        self.census_right = census(to_grey(right), CENSUS_RADIUS)
+
+    def terms(self, disp_l: np.ndarray) -> dict[str, float]:
+        """The terms (fractions, 0 best) of a left disparity map (px, NaN = none)."""
+        bits = (2 * CENSUS_RADIUS + 1) ** 2 - 1
+        return dict(zip(TERMS, _terms(np.ascontiguousarray(disp_l, np.float32),
+                                      self.census_left, self.census_right, self.grey, bits,
+                                      EDGE_SIGMA)))
+
+
 def terms(left: np.ndarray, right: np.ndarray, params: MatcherParams) -> dict[str, float]:
     """The terms (fractions, 0 best) of the matcher's disparity for one rectified pair."""
     return terms_of_maps(left, right, compute_disparity(left, right, params))
@@ -150,11 +167,7 @@ def terms(left: np.ndarray, right: np.ndarray, params: MatcherParams) -> dict[st
 
 def terms_of_maps(left: np.ndarray, right: np.ndarray, disp_l: np.ndarray) -> dict[str, float]:
     """The terms for a given left disparity map (px, NaN = none)."""
-    gl, gr = to_grey(left), to_grey(right)
-    cl, cr = census(gl, CENSUS_RADIUS), census(gr, CENSUS_RADIUS)
-    bits = (2 * CENSUS_RADIUS + 1) ** 2 - 1
-    return dict(zip(TERMS, _terms(np.ascontiguousarray(disp_l, np.float32), cl, cr, gl, bits,
-                                  EDGE_SIGMA)))
+    return Pair(left, right).terms(disp_l)
 
 
 def score_of(t: dict[str, float], w: Weights = Weights()) -> float:
@@ -174,7 +187,14 @@ class SelfSupervisedScore:
     def __init__(self, pairs: Sequence[tuple[np.ndarray, np.ndarray]],
                  ranges: Sequence[tuple[int, int]], weights: Weights = Weights()) -> None:
         self.pairs, self.ranges, self.weights = list(pairs), list(ranges), weights
+        self._prepared: list[Pair] | None = None  # made on first use, in the worker
+
+    def __getstate__(self) -> dict:
+        return self.__dict__ | {"_prepared": None}  # send the images, not their census
 
     def __call__(self, params: MatcherParams) -> list[float]:
-        return [score_of(terms(left, right, apply_range(params, r)), self.weights)
-                for (left, right), r in zip(self.pairs, self.ranges)]
+        if self._prepared is None:
+            self._prepared = [Pair(left, right) for left, right in self.pairs]
+        return [score_of(pair.terms(compute_disparity(pair.left, pair.right,
+                                                      apply_range(params, r))), self.weights)
+                for pair, r in zip(self._prepared, self.ranges)]
