@@ -132,7 +132,10 @@ def _check_args(args: argparse.Namespace) -> int:
 
 def _camera_scenes(args: argparse.Namespace) -> tuple[list[Scene], float | None]:
     """Pairs from --camera as scenes without ground truth, and focal_px * baseline_m when the
-    geometry is known (calibration or simulation)."""
+    geometry is known (calibration or simulation). The right view is brought to the left's
+    exposure as `host servo` does before it matches, so the tuned parameters fit what the servo
+    matches."""
+    from host.servo.perception import match_exposure
     from host.tuning.frames import sim_pairs, spread_pairs
 
     focal_baseline = None
@@ -146,7 +149,7 @@ def _camera_scenes(args: argparse.Namespace) -> tuple[list[Scene], float | None]
 
             g = Calibration.load(args.calib).geometry
             focal_baseline = g.focal_px * g.baseline_m
-    return [Scene(f"{args.camera.split(':')[0]}-{i}", left, right)
+    return [Scene(f"{args.camera.split(':')[0]}-{i}", left, match_exposure(left, right))
             for i, (left, right) in enumerate(pairs)], focal_baseline
 
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -125,6 +127,31 @@ def test_tune_on_replayed_frames_without_ground_truth(tmp_path, scene) -> None:
                                                                              "replay-1"]
     assert params.block_size in (5, 7, 9)
     assert load_disparity_range(out)["policy"] == "coarse"
+
+
+def test_tuning_on_a_camera_is_not_misled_by_unequal_sensor_gains(tmp_path) -> None:
+    """The servo matches the right view's exposure to the left's before it matches; tuning on
+    the camera's frames does the same, so a darker right sensor changes neither the pick nor
+    (much) the score."""
+    import cv2
+
+    def tune_on(gain: float, name: str) -> tuple[str, float]:
+        frames = tmp_path / name
+        frames.mkdir()
+        s = synthetic_scene(seed=7, width=160, height=120, max_disp=20, noise=1.0)
+        right = np.clip(s.right.astype(np.float32) * gain + 12 * (gain != 1), 0, 255)
+        cv2.imwrite(str(frames / "left_000.png"), s.left)
+        cv2.imwrite(str(frames / "right_000.png"), right.astype(np.uint8))
+        r = _tune("--camera", f"replay:{frames}", "--objective", "self", "--method", "grid",
+                  "--space", "sad", "--windows", "5:9", "--border", "clip", "--frames", "1",
+                  "--json")
+        assert r.returncode == 0, r.stderr
+        out = json.loads(r.stdout)
+        return json.dumps(out["best_params"], sort_keys=True), out["best_bad"]
+
+    same, dark = tune_on(1.0, "same"), tune_on(0.6, "dark")
+    assert dark[0] == same[0], (same, dark)
+    assert abs(dark[1] - same[1]) < 1.0, (same, dark)
 
 
 def test_tune_on_the_simulated_camera_with_its_depth_range(tmp_path) -> None:
