@@ -24,6 +24,7 @@ shared Middlebury scenes and tested scene by scene on a choice made without that
 
 from __future__ import annotations
 
+import uuid
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -176,10 +177,17 @@ def score_of(t: dict[str, float], w: Weights = Weights()) -> float:
                   + w.invalid * t["invalid"] + w.roughness * t["roughness"])
 
 
+_PREPARED: dict[str, list[Pair]] = {}  # this process's census of each score's pairs, by key
+_KEEP = 4  # scores whose census a process keeps
+
+
 class SelfSupervisedScore:
     """params -> self-supervised score per pair (lower is better); picklable for any backend.
 
-    pairs are (left, right) uint8 images; ranges their (min_disparity, num_disparities)."""
+    pairs are (left, right) uint8 images; ranges their (min_disparity, num_disparities). The
+    census of the pairs is made once per process, on first use, and kept under a key that
+    travels with the score: worker processes and Ray tasks (which unpickle a fresh copy of the
+    score for every task) share it, and it is never sent."""
 
     name = ("self-supervised (census reconstruction of the right view, holes, hidden, invalid, "
             "roughness)")
@@ -187,14 +195,17 @@ class SelfSupervisedScore:
     def __init__(self, pairs: Sequence[tuple[np.ndarray, np.ndarray]],
                  ranges: Sequence[tuple[int, int]], weights: Weights = Weights()) -> None:
         self.pairs, self.ranges, self.weights = list(pairs), list(ranges), weights
-        self._prepared: list[Pair] | None = None  # made on first use, in the worker
+        self.key = uuid.uuid4().hex
 
-    def __getstate__(self) -> dict:
-        return self.__dict__ | {"_prepared": None}  # send the images, not their census
+    def prepared(self) -> list[Pair]:
+        """This process's census of the pairs (made on first use)."""
+        if self.key not in _PREPARED:
+            while len(_PREPARED) >= _KEEP:
+                _PREPARED.pop(next(iter(_PREPARED)))
+            _PREPARED[self.key] = [Pair(left, right) for left, right in self.pairs]
+        return _PREPARED[self.key]
 
     def __call__(self, params: MatcherParams) -> list[float]:
-        if self._prepared is None:
-            self._prepared = [Pair(left, right) for left, right in self.pairs]
         return [score_of(pair.terms(compute_disparity(pair.left, pair.right,
                                                       apply_range(params, r))), self.weights)
-                for pair, r in zip(self._prepared, self.ranges)]
+                for pair, r in zip(self.prepared(), self.ranges)]
