@@ -45,7 +45,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="scenes with ground truth (default: the embedded Motorcycle pair)")
     p.add_argument("--objective", choices=("gt", "self"), default="gt",
                    help="gt: bad %% against ground truth; self: self-supervised (census "
-                        "reconstruction of the right view, holes, LR consistency, invalid, "
+                        "reconstruction of the right view, holes, hidden, invalid, "
                         "roughness), no ground truth")
     p.add_argument("--frames", type=COUNT, default=4, metavar="N",
                    help="--camera: tune on N pairs spread over what the camera gives")

@@ -37,6 +37,7 @@ from host.stereo.params import MatcherParams
 from host.tuning.disparity_range import apply_range
 
 CENSUS_RADIUS = 3  # 7x7 window: 48 comparison bits
+CENSUS_BITS = (2 * CENSUS_RADIUS + 1) ** 2 - 1
 EDGE_SIGMA = 8.0  # grey levels
 
 
@@ -155,15 +156,9 @@ class Pair:
 
     def terms(self, disp_l: np.ndarray) -> dict[str, float]:
         """The terms (fractions, 0 best) of a left disparity map (px, NaN = none)."""
-        bits = (2 * CENSUS_RADIUS + 1) ** 2 - 1
         return dict(zip(TERMS, _terms(np.ascontiguousarray(disp_l, np.float32),
-                                      self.census_left, self.census_right, self.grey, bits,
-                                      EDGE_SIGMA)))
-
-
-def terms(left: np.ndarray, right: np.ndarray, params: MatcherParams) -> dict[str, float]:
-    """The terms (fractions, 0 best) of the matcher's disparity for one rectified pair."""
-    return terms_of_maps(left, right, compute_disparity(left, right, params))
+                                      self.census_left, self.census_right, self.grey,
+                                      CENSUS_BITS, EDGE_SIGMA)))
 
 
 def terms_of_maps(left: np.ndarray, right: np.ndarray, disp_l: np.ndarray) -> dict[str, float]:
