@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+import numpy as np
+
 from host.errors import HostError
 from host.stereo.matcher import compute_disparity
 from host.stereo.metrics import evaluate
@@ -12,12 +14,16 @@ from host.stereo.scenes import Scene
 from host.tuning.disparity_range import apply_range
 
 
-def scene_bad(scene: Scene, params: MatcherParams, rho: float = 1.0) -> float:
-    """Bad % of params on one scene: over the nonocc region where the scene has that mask,
-    else over every pixel with known ground truth."""
+def map_bad(scene: Scene, disp: np.ndarray, rho: float = 1.0) -> float:
+    """Bad % of a disparity map of the scene: over the nonocc region where the scene has that
+    mask, else over every pixel with known ground truth."""
     assert scene.gt is not None
-    disp = compute_disparity(scene.left, scene.right, params)
     return evaluate(disp, scene.gt, scene.masks.get("nonocc"), rho).bad
+
+
+def scene_bad(scene: Scene, params: MatcherParams, rho: float = 1.0) -> float:
+    """Bad % of params on one scene (map_bad of its disparity)."""
+    return map_bad(scene, compute_disparity(scene.left, scene.right, params), rho)
 
 
 class GroundTruthScore:
