@@ -116,8 +116,9 @@ def nearest_object(disp: np.ndarray, min_area: int, step: float = 0.5,
         n, _, stats = seen[k]
         return n > 1 and int(stats[1:, cv2.CC_STAT_AREA].max()) >= min_area
 
+    missing = f"no object of at least {min_area} px found in the reference scene"
     if not levels:
-        raise HostError(f"no object of at least {min_area} px found in the reference scene")
+        raise HostError(missing)
     last = len(levels) - 1
     start = 0 if near is None else min(last, max(0, round((top - near) / step)))
     jump = 1
@@ -129,8 +130,7 @@ def nearest_object(disp: np.ndarray, min_area: int, step: float = 0.5,
         below, k = start, min(last, start + 1)
         while not reaches(k):
             if k == last:
-                raise HostError(f"no object of at least {min_area} px found in the reference "
-                                f"scene")
+                raise HostError(missing)
             below, jump = k, 2 * jump
             k = min(last, k + jump)
     while k - below > 1:

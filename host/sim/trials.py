@@ -194,9 +194,8 @@ def run_trials(n: int, seed: int, size: tuple[int, int], params: MatcherParams,
                                                        else range(n))]
     trials: list[Trial] = []
     world = "nominal" if nominal else "faulty"
-    print(f"{len(jobs)} of {n} trials of the {world} world at {size[0]}x{size[1]}, seed {seed}"
-          if indices else f"{n} trials of the {world} world at {size[0]}x{size[1]}, seed {seed}",
-          file=out)
+    which = f"{len(jobs)} of {n}" if indices else f"{n}"
+    print(f"{which} trials of the {world} world at {size[0]}x{size[1]}, seed {seed}", file=out)
     ctx = multiprocessing.get_context("spawn")
     with ctx.Pool(max(1, min(workers, len(jobs)))) as pool:
         for t in pool.imap(run_trial, jobs):
