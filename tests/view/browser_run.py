@@ -22,8 +22,7 @@ FLAGS = ["--no-sandbox", "--disable-background-networking", "--disable-component
          "--metrics-recording-only", "--disable-features=MediaRouter,OptimizationHints"]
 
 
-def read_dom(page) -> dict:
-    return page.evaluate("""() => {
+READ_DOM = """() => {
         const q = (id) => document.getElementById(id);
         const vis = (id) => q(id).getAttribute('visibility') === 'visible';
         const body = document.body.dataset;
@@ -41,7 +40,11 @@ def read_dom(page) -> dict:
                 left_loaded: q('left').naturalWidth,
                 disparity_loaded: q('disparity').naturalWidth,
                 stop_enabled: !q('stop').disabled};
-    }""")
+    }"""
+
+
+def read_dom(page) -> dict:
+    return page.evaluate(READ_DOM)
 
 
 def main(out: Path) -> None:
@@ -70,12 +73,13 @@ def main(out: Path) -> None:
             browser = pw.chromium.launch(executable_path=CHROMIUM, headless=True, args=FLAGS)
             page = browser.new_page(viewport={"width": 1280, "height": 900})
             page.goto(url)
-            # images decode asynchronously after an update: wait for both, not for the update alone
-            page.wait_for_function(
-                "+(document.body.dataset.updates || 0) >= 1 && "
-                "document.getElementById('left').naturalWidth > 0 && "
-                "document.getElementById('disparity').naturalWidth > 0", timeout=30000)
-            result["samples"].append(read_dom(page))
+            # images decode asynchronously after an update, and a later update starts decoding
+            # anew (naturalWidth 0 until it is done): take the first sample in the same moment
+            # that sees both pictures decoded, not in a second call after it
+            first = page.wait_for_function(
+                f"() => {{ const r = ({READ_DOM})(); return r.updates >= 1 && "
+                "r.left_loaded > 0 && r.disparity_loaded > 0 ? r : null; }", timeout=30000)
+            result["samples"].append(first.json_value())
             # on until the robot is seen and driven, and its depth has been plotted a while
             page.wait_for_function(
                 "document.getElementById('phase').textContent !== 'reference' && "
