@@ -101,6 +101,14 @@ static void on_set_drive(const struct frame *f)
     if (m.left == 998 && m.right == -998) /* test build only: a stall in the main loop, */
         for (volatile uint32_t i = 0; i < 30000UL; i++) /* long enough to fill the RX ring */
             ;
+    if (m.left == 997) /* test build only: a stall of -right ms (330 turns a ms) */
+        for (volatile uint32_t i = 0; i < (uint32_t)-m.right * 330UL; i++)
+            ;
+    if (m.left == 996 && m.right == -996) { /* test build only: a hang with interrupts off */
+        board_lock();
+        for (;;)
+            ;
+    }
 #endif
     uint8_t state = board_lock();
     link_heard(&link, robot.now_ms);

@@ -10,6 +10,11 @@
  *                so the receiver overruns when the firmware falls behind
  *   run MS       simulate MS milliseconds
  *   quiet 0|1    stop or start printing each "in" byte (counts are kept either way)
+ *   fill SEED    fill SRAM (0x100-0x8FF) with a pseudo-random pattern from SEED, as a real
+ *                chip powers up with RAM undefined (simavr starts it zeroed); before any run
+ *   poke ADDR HEX write bytes into the data space at ADDR (hex), e.g. a .noinit record or MCUSR
+ *   reset FLAGS  reset the chip now, RAM kept (as on a real chip), MCUSR = FLAGS (hex): 0 is
+ *                what the application sees behind optiboot 4.4
  * Events on stdout, times in CPU cycles since power-on:
  *   in CYCLE BYTE              a byte entered UART0 (its start bit)
  *   tx CYCLE BYTE              UART0 sent a byte
@@ -216,6 +221,42 @@ static double wall(void)
     return t.tv_sec + t.tv_nsec * 1e-9;
 }
 
+static void fill(unsigned seed)
+{
+    uint32_t x = seed * 2654435761u + 1;
+    for (unsigned a = 0x100; a <= 0x8FF; a++) {
+        x ^= x << 13, x ^= x >> 17, x ^= x << 5;
+        h.avr->data[a] = (uint8_t)(x >> 24);
+    }
+}
+
+static void poke(const char *args)
+{
+    unsigned addr, v;
+    int n;
+    if (sscanf(args, "%x %n", &addr, &n) != 1)
+        return;
+    for (args += n; args[0] && args[1] && sscanf(args, "%2x", &v) == 1 && addr <= 0x8FF; args += 2)
+        h.avr->data[addr++] = (uint8_t)v;
+}
+
+static void reset_now(unsigned flags)
+{
+    uint8_t ram[0x800];
+    memcpy(ram, h.avr->data + 0x100, sizeof ram);
+    avr_cycle_count_t cycle = h.avr->cycle;
+    avr_reset(h.avr);
+    if (h.avr->cycle < cycle) /* keep one time line across the reset */
+        h.avr->cycle = cycle;
+    memcpy(h.avr->data + 0x100, ram, sizeof ram);
+    h.avr->data[0x54] = (uint8_t)flags;
+    h.resets++;
+    h.xon = 0;
+    h.feeding = 0;
+    start_feeding();
+    fprintf(h.events, "reset %llu\n", (unsigned long long)h.avr->cycle);
+}
+
 static int scripted(void)
 {
     char *line = NULL;
@@ -225,6 +266,7 @@ static int scripted(void)
     while (getline(&line, &cap, stdin) > 0) {
         char cmd[16];
         double arg = 0;
+        unsigned flags;
         if (sscanf(line, "%15s", cmd) != 1)
             continue;
         if (!strcmp(cmd, "send"))
@@ -233,6 +275,12 @@ static int scripted(void)
             h.quiet = arg != 0;
         else if (!strcmp(cmd, "flow") && sscanf(line + 5, "%lf", &arg) == 1)
             h.flow = arg != 0;
+        else if (!strcmp(cmd, "fill") && sscanf(line + 5, "%lf", &arg) == 1)
+            fill((unsigned)arg);
+        else if (!strcmp(cmd, "poke"))
+            poke(line + 5);
+        else if (!strcmp(cmd, "reset") && sscanf(line + 6, "%x", &flags) == 1)
+            reset_now(flags);
         else if (!strcmp(cmd, "run") && sscanf(line + 4, "%lf", &arg) == 1) {
             if (run_until(h.avr->cycle + (avr_cycle_count_t)(arg * F_CPU / 1000)) < 0)
                 return 1;
