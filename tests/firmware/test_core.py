@@ -43,3 +43,26 @@ def test_a_resend_handled_right_after_a_trip_is_applied_not_a_duplicate(core) ->
     for t in range(254, 300):  # the coast after the stop, then driven again
         core.tick(t)
     assert core.motors() == (400, 400)
+
+
+def test_the_ramp_budget_never_moves_a_motor_faster_than_the_limit_after_a_long_tick(core) -> None:
+    """Defect 3 of issue 29 (the budget wrapped at 16 bits): at the largest acceleration limit
+    a 30 ms tick spent coasting, then a 1 ms tick, moved the duty 0 -> 444 (limit 100 a ms)."""
+    limit = 10000  # the spec's largest accel_limit
+    send(core, 0, gen.SetConfig(link_timeout_ms=5000, accel_limit=limit), 0)
+    send(core, 1, gen.SetDrive(left=500, right=500), 0)
+    t = 0
+    while core.motors() != (500, 500):
+        t += 1
+        core.tick(t)
+    send(core, 2, gen.SetDrive(left=-1000, right=-1000), t)
+    while core.motors() != (0, 0):  # ramps down to zero, then coasts
+        t += 1
+        core.tick(t)
+    before = core.motors()[0]
+    for step in (30, 1, 1, 1):  # a long tick (a slow main-loop pass), then ordinary ones
+        t += step
+        core.tick(t)
+        now = core.motors()[0]
+        assert abs(now - before) <= limit // 100 * step, (step, before, now)
+        before = now

@@ -54,7 +54,9 @@ uint8_t drive_tick(struct drive *d, uint16_t elapsed_ms)
         /* accel_limit permille per 100 ms = accel_limit / 100 permille per ms */
         uint32_t budget = d->budget + (uint32_t)d->accel_limit * elapsed_ms;
         step = budget / 100 > 2000 ? 2000 : (uint16_t)(budget / 100);
-        d->budget = drive_ramping(d) ? (uint16_t)(budget - (uint32_t)step * 100) : 0;
+        /* only the fraction of a permille is carried: a capped step (a long tick) moves as
+         * far as any change can, and what it did not spend is not owed to the next tick */
+        d->budget = drive_ramping(d) ? (uint8_t)(budget % 100) : 0;
     }
     uint8_t changed = 0;
     for (uint8_t m = DRIVE_LEFT; m <= DRIVE_RIGHT; m++) {

@@ -12,7 +12,8 @@ struct drive {
     int16_t applied[2];   /* duty applied to the motors now, permille */
     uint16_t coast_ms[2]; /* ms the motor must still stay at zero (bridge off) */
     uint16_t accel_limit; /* largest change per 100 ms, permille; 0 = none */
-    uint16_t budget;      /* accel_limit * elapsed ms not yet spent, in 1/100 permille */
+    uint8_t budget;       /* the fraction of a permille of ramp not yet spent, in 1/100
+                             permille: below 100 by construction, so it cannot wrap */
 };
 
 void drive_init(struct drive *d);
