@@ -148,8 +148,9 @@ def test_the_motors_stop_250_ms_after_the_last_accepted_drive_whatever_follows(
 
 def test_bytes_that_pile_up_while_the_main_loop_stalls_are_counted_as_overruns(
         harness, hang_elf):
-    s = Script().run_ms(2).message(1, gen.SetDrive(left=998, right=-998)).run_ms(1)
-    s.send(flood("get-status", 300)).run_ms(80).message(2, gen.GetStatus()).run_ms(10)
+    # the test build's 25 ms stall (SET_DRIVE 997,-25), within one watchdog period
+    s = Script().run_ms(2).message(1, gen.SetDrive(left=997, right=-25)).run_ms(1)
+    s.send(flood("get-status", 300)).run_ms(40).message(2, gen.GetStatus()).run_ms(10)
     r = run(harness, hang_elf, s)
     status = messages(r)[-1]
     assert status.NAME == "STATUS" and r.resets == []

@@ -79,18 +79,28 @@ uint8_t reset_cause(void)
     return saved_cause;
 }
 
-/* Two 60 ms periods: a hang stops the motors after 60 ms (the interrupt, which clears WDIE) and
- * resets the chip 60 ms later, 120 ms after the last feed as before this mode. */
+/* Interrupt, then reset, at 30 ms periods (32 ms in simavr; the watchdog oscillator's tolerance
+ * stretches them on a chip): a hang with interrupts on stops the motors one period after the
+ * last feed (the interrupt) and resets the chip one period later; a hang with interrupts held
+ * off cannot take the interrupt, and the chip resets at the second time-out. Either way the
+ * motors are stopped within two periods of the last feed. A main-loop pass takes at most a few
+ * ms (config.h), far inside one period. */
 void reset_watchdog_start(void)
 {
-    wdt_enable(WDTO_60MS);
+    wdt_enable(WDTO_30MS);
     WDTCSR |= _BV(WDIE); /* WDE and WDIE: interrupt first, then reset */
 }
 
-/* The firmware hung for a watchdog period: stop the motors now and leave the cause in RAM;
- * the next timeout resets the chip (the interrupt cleared WDIE). */
-ISR(WDT_vect)
+/* The main loop missed a whole watchdog period: stop the motors now, leave the cause in RAM,
+ * and wait here, interrupts off, for the reset at the next time-out (taking this vector cleared
+ * WDIE). Never return: a main loop that merely stalled would otherwise go on with the motors
+ * cut behind the core's back, the interrupt disarmed and the host told nothing; after the reset
+ * it learns of it by BOOT (WATCHDOG), and the drive state starts again from zero. */
+ISR(WDT_vect, ISR_NAKED) /* no prologue: it never returns, so nothing needs saving */
 {
+    __asm__ volatile("clr __zero_reg__"); /* the interrupted code may have left r1 non-zero */
     board_motor_output(0, 0);
     record_mark(MARK_WATCHDOG);
+    for (;;)
+        ;
 }

@@ -7,8 +7,9 @@
 /* proto_reset_cause of the last reset. */
 uint8_t reset_cause(void);
 
-/* Start the watchdog in interrupt-then-reset mode (feed it with wdt_reset()): a hang stops the
- * motors at the interrupt and leaves WATCHDOG in RAM for the next start, then the chip resets. */
+/* Start the watchdog in interrupt-then-reset mode at 30 ms (feed it with wdt_reset()): a pass of
+ * the main loop that misses a period stops the motors at the interrupt and leaves WATCHDOG in RAM
+ * for the next start, then the chip resets; within two periods either way. */
 void reset_watchdog_start(void);
 
 #endif

@@ -98,9 +98,6 @@ static void on_set_drive(const struct frame *f)
     if (m.left == 999 && m.right == -999)
         for (;;) /* test build only: a hang the watchdog must catch */
             ;
-    if (m.left == 998 && m.right == -998) /* test build only: a stall in the main loop, */
-        for (volatile uint32_t i = 0; i < 30000UL; i++) /* long enough to fill the RX ring */
-            ;
     if (m.left == 997) /* test build only: a stall of -right ms (330 turns a ms) */
         for (volatile uint32_t i = 0; i < (uint32_t)-m.right * 330UL; i++)
             ;
