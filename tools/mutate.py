@@ -123,7 +123,15 @@ def _nodeid(case: ET.Element) -> str:
     return f"{cls}::{name}"
 
 
-def _exception(message: str) -> str:
+def _exception(failure: ET.Element) -> str:
+    """The exception type of a failed test: pytest ends its report with "path:line: Type"."""
+    for line in reversed((failure.text or "").strip().splitlines()):
+        m = re.match(r"^\S+:\d+: ([\w.]+)$", line.strip())
+        if m:
+            return m.group(1).rsplit(".", 1)[-1]
+    message = failure.get("message", "")
+    if message.startswith("assert "):
+        return "AssertionError"
     head = message.split(":", 1)[0].strip()
     return head.rsplit(".", 1)[-1] if re.fullmatch(r"[\w.]+", head) else head[:40]
 
@@ -148,7 +156,7 @@ def pytest_run(tree: Path, tests: list[str], deselect: list[str]) -> tuple[list[
         test = _nodeid(case)
         failure, error, skipped = case.find("failure"), case.find("error"), case.find("skipped")
         if failure is not None:
-            exc = _exception(failure.get("message", ""))
+            exc = _exception(failure)
             out.append(Outcome(test, "kill" if exc in KILLING_EXCEPTIONS else "other-failure",
                                exc))
         elif error is not None:

@@ -7,11 +7,11 @@ import enum
 from dataclasses import dataclass
 from typing import ClassVar
 
-SCHEMA_HASH = 0xF490713D
+SCHEMA_HASH = 0x2A2E8069
 VERSION = 1
 BAUD = 115200
 START = 0xA5
-MAX_PAYLOAD = 24
+MAX_PAYLOAD = 26
 HEADER_LEN = 4  # START LEN SEQ ID
 CRC_LEN = 4
 CRC_NAME = "crc-32c"
@@ -19,6 +19,7 @@ DEFAULT_LINK_TIMEOUT_MS = 250
 DEFAULT_ACCEL_LIMIT = 400
 DEFAULT_REVERSE_COAST_MS = 10
 DEFAULT_NACK_INTERVAL_MS = 10
+DEFAULT_FRAME_GAP_MS = 10
 
 
 class Error(enum.IntEnum):
@@ -196,8 +197,8 @@ class Status:
     ID: ClassVar[int] = 0x84
     NAME: ClassVar[str] = "STATUS"
     DIRECTION: ClassVar[str] = "robot_to_host"
-    FORMAT: ClassVar[str] = "<IhhBBHHHHHHH"
-    SIZE: ClassVar[int] = 24
+    FORMAT: ClassVar[str] = "<IhhBBHHHHHHHH"
+    SIZE: ClassVar[int] = 26
     RANGES: ClassVar[dict[str, tuple[int, int]]] = {
         "uptime_ms": (0, 4294967295),
         "left": (-32768, 32767),
@@ -211,6 +212,7 @@ class Status:
         "accel_limit": (0, 65535),
         "rx_overruns": (0, 65535),
         "tx_dropped": (0, 65535),
+        "link_losses": (0, 65535),
     }
     uptime_ms: int  # time since reset, ms
     left: int  # left duty applied now, permille duty
@@ -219,11 +221,12 @@ class Status:
     reset_cause: int  # cause of the last reset
     good_frames: int  # frames received with a good CRC (wraps)
     crc_errors: int  # frames dropped for a bad CRC (wraps)
-    framing_errors: int  # frames dropped for an oversize LEN (wraps)
+    framing_errors: int  # frames dropped for an oversize LEN or a gap of more than frame_gap_ms inside them (wraps)
     link_timeout_ms: int  # link-loss timeout in force, ms
     accel_limit: int  # acceleration limit in force, permille per 100 ms
     rx_overruns: int  # received bytes lost to an overrun of the UART or the receive ring (wraps)
     tx_dropped: int  # replies dropped because the transmit buffer was full (wraps)
+    link_losses: int  # link-loss stops since reset (wraps): LINK_LOST says the last stop was one, this counts them all, also those a later SET_DRIVE cleared
 
 
 @dataclass(frozen=True)

@@ -63,7 +63,7 @@ static inline int proto_format(uint8_t id, const uint8_t *payload, char *out, si
     case PROTO_MSG_STATUS: {
         struct proto_status m;
         proto_status_unpack(payload, &m);
-        return snprintf(out, n, "STATUS uptime_ms=%ld left=%ld right=%ld flags=%ld reset_cause=%ld good_frames=%ld crc_errors=%ld framing_errors=%ld link_timeout_ms=%ld accel_limit=%ld rx_overruns=%ld tx_dropped=%ld", (long)m.uptime_ms, (long)m.left, (long)m.right, (long)m.flags, (long)m.reset_cause, (long)m.good_frames, (long)m.crc_errors, (long)m.framing_errors, (long)m.link_timeout_ms, (long)m.accel_limit, (long)m.rx_overruns, (long)m.tx_dropped);
+        return snprintf(out, n, "STATUS uptime_ms=%ld left=%ld right=%ld flags=%ld reset_cause=%ld good_frames=%ld crc_errors=%ld framing_errors=%ld link_timeout_ms=%ld accel_limit=%ld rx_overruns=%ld tx_dropped=%ld link_losses=%ld", (long)m.uptime_ms, (long)m.left, (long)m.right, (long)m.flags, (long)m.reset_cause, (long)m.good_frames, (long)m.crc_errors, (long)m.framing_errors, (long)m.link_timeout_ms, (long)m.accel_limit, (long)m.rx_overruns, (long)m.tx_dropped, (long)m.link_losses);
     }
     case PROTO_MSG_BOOT: {
         struct proto_boot m;

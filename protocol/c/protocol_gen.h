@@ -6,11 +6,11 @@
 
 #include <stdint.h>
 
-#define PROTO_SCHEMA_HASH 0xF490713DUL
+#define PROTO_SCHEMA_HASH 0x2A2E8069UL
 #define PROTO_VERSION 1
 #define PROTO_BAUD 115200UL
 #define PROTO_START 0xA5
-#define PROTO_MAX_PAYLOAD 24
+#define PROTO_MAX_PAYLOAD 26
 #define PROTO_HEADER_LEN 4 /* START LEN SEQ ID */
 #define PROTO_CRC_LEN 4
 #define PROTO_FRAME_MAX (PROTO_HEADER_LEN + PROTO_MAX_PAYLOAD + PROTO_CRC_LEN)
@@ -20,6 +20,7 @@
 #define PROTO_DEFAULT_ACCEL_LIMIT 400
 #define PROTO_DEFAULT_REVERSE_COAST_MS 10
 #define PROTO_DEFAULT_NACK_INTERVAL_MS 10
+#define PROTO_DEFAULT_FRAME_GAP_MS 10
 
 /* Why a command was refused (NACK.error). */
 enum proto_error {
@@ -226,7 +227,7 @@ static inline void proto_nack_unpack(const uint8_t *p, struct proto_nack *m)
 }
 
 /* STATUS (0x84, robot to host): The robot's state, in answer to GET_STATUS. */
-#define PROTO_STATUS_LEN 24
+#define PROTO_STATUS_LEN 26
 struct proto_status {
     uint32_t uptime_ms; /* time since reset, ms */
     int16_t left; /* left duty applied now, permille duty */
@@ -235,11 +236,12 @@ struct proto_status {
     uint8_t reset_cause; /* cause of the last reset */
     uint16_t good_frames; /* frames received with a good CRC (wraps) */
     uint16_t crc_errors; /* frames dropped for a bad CRC (wraps) */
-    uint16_t framing_errors; /* frames dropped for an oversize LEN (wraps) */
+    uint16_t framing_errors; /* frames dropped for an oversize LEN or a gap of more than frame_gap_ms inside them (wraps) */
     uint16_t link_timeout_ms; /* link-loss timeout in force, ms */
     uint16_t accel_limit; /* acceleration limit in force, permille per 100 ms */
     uint16_t rx_overruns; /* received bytes lost to an overrun of the UART or the receive ring (wraps) */
     uint16_t tx_dropped; /* replies dropped because the transmit buffer was full (wraps) */
+    uint16_t link_losses; /* link-loss stops since reset (wraps): LINK_LOST says the last stop was one, this counts them all, also those a later SET_DRIVE cleared */
 };
 
 static inline void proto_status_pack(uint8_t *p, const struct proto_status *m)
@@ -268,6 +270,8 @@ static inline void proto_status_pack(uint8_t *p, const struct proto_status *m)
     p[21] = (uint8_t)((uint16_t)m->rx_overruns >> 8);
     p[22] = (uint8_t)((uint16_t)m->tx_dropped);
     p[23] = (uint8_t)((uint16_t)m->tx_dropped >> 8);
+    p[24] = (uint8_t)((uint16_t)m->link_losses);
+    p[25] = (uint8_t)((uint16_t)m->link_losses >> 8);
 }
 
 static inline void proto_status_unpack(const uint8_t *p, struct proto_status *m)
@@ -284,6 +288,7 @@ static inline void proto_status_unpack(const uint8_t *p, struct proto_status *m)
     m->accel_limit = (uint16_t)((uint16_t)p[18] | ((uint16_t)p[19] << 8));
     m->rx_overruns = (uint16_t)((uint16_t)p[20] | ((uint16_t)p[21] << 8));
     m->tx_dropped = (uint16_t)((uint16_t)p[22] | ((uint16_t)p[23] << 8));
+    m->link_losses = (uint16_t)((uint16_t)p[24] | ((uint16_t)p[25] << 8));
 }
 
 /* BOOT (0x85, robot to host): Sent once after every reset, unasked, so the host knows the board (re)started. */

@@ -4,10 +4,11 @@
  *
  * Each iteration runs three checks: a random byte stream (the parser must not fault, and every
  * frame it hands over must have a valid length); a valid frame hit by a burst error of 1..16
- * bits (CRC-16 detects every such burst: an accepted different frame is a failure); and random
- * garbage, a valid frame, then padding (the frame must come out, unless garbage formed a frame
- * with a good CRC by chance, which is counted). It also corrupts 2..4 bytes at random places,
- * outside CRC-16's guarantee, and reports how many of those were accepted.
+ * bits (CRC-32C, like every CRC of 32 bits, detects every burst of up to 32 bits: an accepted
+ * different frame is a failure); and random garbage, a valid frame, then padding (the frame must
+ * come out, unless garbage formed a frame with a good CRC by chance, which is counted). It also
+ * corrupts 2..4 bytes at random places, outside the burst guarantee, and reports how many of
+ * those were accepted.
  * Exit status 1 when a check fails. */
 #include <stdio.h>
 #include <stdlib.h>
@@ -128,8 +129,8 @@ int main(int argc, char **argv)
         if (c.count && same(&c, frame, payload, len)) {
             junk_frames += c.count - 1u;
         } else if (c.count) {
-            /* garbage formed a frame with a good CRC by chance (about 2^-16 per false START)
-             * and it took the real frame's first bytes: CRC-16's limit, not a parser fault */
+            /* garbage formed a frame with a good CRC by chance (about 2^-32 per false START)
+             * and it took the real frame's first bytes: the CRC's limit, not a parser fault */
             junk_frames += c.count;
             junk_messages += c.valid_messages;
         } else {

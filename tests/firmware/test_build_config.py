@@ -56,7 +56,7 @@ def test_same_includes_defines_and_warnings(make_config, pio) -> None:
     pio_defines = {f[2:] for f in flags if f.startswith("-D")}
     assert pio_defines == make_defines
     make_flags = set(make_config["CFLAGS"].split())
-    for flag in ("-std=gnu11", "-Os", "-flto", "-Wall", "-Wextra", "-Werror"):
+    for flag in ("-std=gnu11", "-Os", "-flto", "-mrelax", "-Wall", "-Wextra", "-Werror"):
         assert flag in flags and flag in make_flags
 
 

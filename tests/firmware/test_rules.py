@@ -301,3 +301,50 @@ def test_a_burst_during_a_short_stall_is_held_by_the_receive_ring(harness, hang_
     got = messages(r)
     assert [m.seq for m in got if m.NAME == "ACK"] == [0, 1, 2, 3, 4, 5]
     assert got[-1].NAME == "STATUS" and got[-1].rx_overruns == 0
+
+
+# --- frame gap and link-loss count (issue 29, defect 2) ---
+
+
+def test_a_false_start_on_the_line_does_not_swallow_the_keepalives(harness, firmware_elf) -> None:
+    """Noise that reads as START and the largest LEN used to swallow the next 31 bytes: the
+    next keepalives, so the motors were cut by link loss. Now the partial frame is dropped at
+    the gap before the next keepalive."""
+    drive = gen.SetDrive(left=500, right=500)
+    p = Plan().run(2).msg(0, NO_RAMP).run(2).msg(1, drive, "drive").run(40)
+    p.send(bytes([gen.START, gen.MAX_PAYLOAD])).run(40)
+    for _ in range(10):  # the same SET_DRIVE every 80 ms: ACK DUPLICATE, deadline restarted
+        p.msg(1, drive).run(80)
+    p.msg(2, gen.GetStatus()).run(5)
+    r = run(harness, firmware_elf, p.script)
+    t = [d for d in timeline(r.io, "left") if d.cycle > done(r, p, "drive")]
+    on = next(i for i, d in enumerate(t) if driving(d))
+    assert all(driving(d) for d in t[on:]), "the motors were cut"
+    status = messages(r)[-1]
+    assert status.NAME == "STATUS" and status.link_losses == 0
+    assert not status.flags & gen.StatusFlag.LINK_LOST and status.framing_errors == 1
+
+
+def test_a_frame_with_gaps_between_its_bytes_is_dropped(harness, firmware_elf) -> None:
+    frame = encode_frame(3, *pack(gen.SetDrive(left=400, right=400)))
+    p = Plan().run(2).msg(0, NO_RAMP).run(2)
+    for b in frame:
+        p.send(bytes([b])).run(gen.DEFAULT_FRAME_GAP_MS + 2)
+    p.msg(4, gen.GetStatus()).run(5).msg(5, gen.SetDrive(left=300, right=300)).run(5)
+    r = run(harness, firmware_elf, p.script)
+    got = messages(r)
+    assert [m.seq for m in got if m.NAME == "ACK"] == [0, 5]  # the gapped frame never counted
+    status = next(m for m in got if m.NAME == "STATUS")
+    assert status.framing_errors >= 1 and status.left == 0
+    assert timeline(r.io, "left")[-1].enable.duty == 0.3
+
+
+def test_status_counts_every_link_loss_stop(harness, firmware_elf) -> None:
+    p = Plan().run(2).msg(0, NO_RAMP).run(2)
+    for seq in (1, 2):
+        p.msg(seq, gen.SetDrive(left=300, right=300)).run(gen.DEFAULT_LINK_TIMEOUT_MS + 20)
+    p.msg(3, gen.SetDrive(left=300, right=300)).run(5).msg(4, gen.GetStatus()).run(5)
+    r = run(harness, firmware_elf, p.script)
+    status = messages(r)[-1]
+    assert status.NAME == "STATUS" and status.link_losses == 2
+    assert not status.flags & gen.StatusFlag.LINK_LOST  # cleared by the last SET_DRIVE

@@ -3,6 +3,8 @@ recognises resends by (SEQ, ID) only, as the old firmware did."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import pytest
 
 from host.link import protocol_gen as gen
@@ -35,7 +37,7 @@ class OldRobot:
                 self._send(gen.HelloReply(nonce=msg.nonce, schema_hash=gen.SCHEMA_HASH,
                                           fw_version=0x100, reset_cause=1, link_timeout_ms=250))
             elif isinstance(msg, gen.GetStatus):
-                self._send(gen.Status(*[0] * 12))
+                self._send(gen.Status(*[0] * len(dataclasses.fields(gen.Status))))
             else:
                 result = gen.AckResult.APPLIED
                 if self.last == (f.seq, f.id):

@@ -27,6 +27,8 @@ static struct {
     uint8_t tx_seq;
     uint8_t nack_credit; /* NACKs that may still be sent now (NACK_BURST at most) */
     uint8_t nack_ms;     /* ms towards the next credit */
+    uint8_t rx_ms;       /* low byte of the time of the last received byte (frame gap) */
+    uint16_t link_losses;
     uint8_t have_last;   /* last_* hold the last applied command */
     uint8_t last_seq;
     uint8_t last_id;
@@ -141,7 +143,7 @@ static void on_get_status(void)
         robot.now_ms, robot.drive.applied[DRIVE_LEFT], robot.drive.applied[DRIVE_RIGHT],
         status_flags(), robot.reset_cause, robot.parser.good_frames, robot.parser.crc_errors,
         robot.parser.framing_errors, link.timeout_ms, robot.drive.accel_limit,
-        board_rx_overruns(), board_tx_dropped()};
+        board_rx_overruns(), board_tx_dropped(), robot.link_losses};
     uint8_t p[PROTO_STATUS_LEN];
     proto_status_pack(p, &m);
     send(PROTO_MSG_STATUS, p, sizeof p);
@@ -214,6 +216,7 @@ static uint8_t catch_up_guard(void)
     if (!tripped)
         return 0;
     link.lost = 1;
+    robot.link_losses++;
     robot.have_last = 0; /* a resend after this stop is applied again, not a duplicate */
     stop();
     return 1;
@@ -256,6 +259,7 @@ void robot_init(uint8_t reset_cause, uint32_t now_ms)
     robot.have_last = 0;
     robot.nack_credit = NACK_BURST;
     robot.nack_ms = 0;
+    robot.link_losses = 0;
     stop();
     struct proto_boot m = {reset_cause, FW_VERSION, PROTO_SCHEMA_HASH};
     uint8_t p[PROTO_BOOT_LEN];
@@ -266,6 +270,7 @@ void robot_init(uint8_t reset_cause, uint32_t now_ms)
 void robot_rx_byte(uint8_t byte, uint32_t now_ms)
 {
     robot.now_ms = now_ms;
+    robot.rx_ms = (uint8_t)now_ms;
     if (frame_parse_byte(&robot.parser, byte, on_frame, 0) &&
         proto_is_host_to_robot(robot.parser.last_id))
         send_nack(robot.parser.last_seq, PROTO_ERROR_BAD_CRC);
@@ -288,6 +293,13 @@ void robot_tick(uint32_t now_ms)
     uint16_t elapsed = (uint16_t)(now_ms - robot.last_tick_ms);
     robot.last_tick_ms = now_ms;
     refill_nacks(elapsed);
+    /* a partial frame whose next byte is overdue is dropped: checked every tick, so the 8-bit
+     * difference is read long before it could wrap */
+    if (robot.parser.state != FRAME_WAIT_START &&
+        (uint8_t)((uint8_t)now_ms - robot.rx_ms) > PROTO_DEFAULT_FRAME_GAP_MS) {
+        robot.parser.state = FRAME_WAIT_START;
+        robot.parser.framing_errors++;
+    }
     if (!catch_up_guard() && drive_tick(&robot.drive, elapsed))
         output();
 }

@@ -13,6 +13,8 @@
  *   fill SEED    fill SRAM (0x100-0x8FF) with a pseudo-random pattern from SEED, as a real
  *                chip powers up with RAM undefined (simavr starts it zeroed); before any run
  *   poke ADDR HEX write bytes into the data space at ADDR (hex), e.g. a .noinit record or MCUSR
+ *   stack SEED ADDR  print "stack LOWEST": the lowest address from ADDR (hex) up whose byte
+ *                no longer holds the pattern of fill SEED: the stack's deepest point so far
  *   reset FLAGS  reset the chip now, RAM kept (as on a real chip), MCUSR = FLAGS (hex): 0 is
  *                what the application sees behind optiboot 4.4
  * Events on stdout, times in CPU cycles since power-on:
@@ -262,6 +264,21 @@ static void fill(unsigned seed)
     }
 }
 
+/* The lowest address from `from` up that no longer holds the fill pattern: with RAM filled at
+ * power-on, the deepest the stack has reached (a write of the very byte the pattern had there
+ * goes unseen, so this may miss a byte or so). Prints "stack LOWEST". */
+static void stack_mark(unsigned seed, unsigned from)
+{
+    uint32_t x = seed * 2654435761u + 1;
+    unsigned lowest = 0x900;
+    for (unsigned a = 0x100; a <= 0x8FF; a++) {
+        x ^= x << 13, x ^= x >> 17, x ^= x << 5;
+        if (a >= from && lowest == 0x900 && h.avr->data[a] != (uint8_t)(x >> 24))
+            lowest = a;
+    }
+    printf("stack %x\n", lowest);
+}
+
 static void poke(const char *args)
 {
     unsigned addr, v;
@@ -298,7 +315,7 @@ static int scripted(void)
     while (getline(&line, &cap, stdin) > 0) {
         char cmd[16];
         double arg = 0;
-        unsigned flags;
+        unsigned flags, seed;
         if (sscanf(line, "%15s", cmd) != 1)
             continue;
         if (!strcmp(cmd, "send"))
@@ -309,6 +326,8 @@ static int scripted(void)
             h.flow = arg != 0;
         else if (!strcmp(cmd, "fill") && sscanf(line + 5, "%lf", &arg) == 1)
             fill((unsigned)arg);
+        else if (!strcmp(cmd, "stack") && sscanf(line + 6, "%u %x", &seed, &flags) == 2)
+            stack_mark(seed, flags);
         else if (!strcmp(cmd, "poke"))
             poke(line + 5);
         else if (!strcmp(cmd, "reset") && sscanf(line + 6, "%x", &flags) == 1)
