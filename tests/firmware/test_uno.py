@@ -72,9 +72,13 @@ def _assert_image(flash: Path, hex_file: Path) -> None:
 def _works(port: str) -> None:
     with RobotLink(port, handshake_s=5) as robot:
         assert robot.hello.schema_hash == gen.SCHEMA_HASH
-        robot.set_config(gen.DEFAULT_LINK_TIMEOUT_MS, accel_limit=0)  # unramped, to read back
+        # unramped, to read back; the longest link timeout, so that a loaded machine's delay
+        # between the drive and the status read cannot be a link-loss stop (issue 29: the
+        # status was read twice under 250 ms and the second read found the motors stopped)
+        robot.set_config(5000, accel_limit=0)
         robot.drive(250, -250)
-        assert (robot.status().left, robot.status().right) == (250, -250)
+        status = robot.status()
+        assert (status.left, status.right) == (250, -250)
 
 
 def test_make_flash_programs_the_uno_through_optiboot_and_the_flashed_firmware_says_hello(
