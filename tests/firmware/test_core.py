@@ -66,3 +66,40 @@ def test_the_ramp_budget_never_moves_a_motor_faster_than_the_limit_after_a_long_
         now = core.motors()[0]
         assert abs(now - before) <= limit // 100 * step, (step, before, now)
         before = now
+
+
+def test_stop_after_a_long_pass_still_coasts_the_whole_interval(core) -> None:
+    """The core fuzzer's finding (tests/c/corpus/core/stop-after-a-long-pass-coasts-short): the
+    coast that STOP starts was counted down from the last tick before it, so after a pass of
+    5 ms a reversal drove the bridge again 6 ms after the stop instead of 10."""
+    send(core, 0, gen.SetConfig(link_timeout_ms=5000, accel_limit=0), 0)
+    send(core, 1, gen.SetDrive(left=500, right=500), 0)
+    for t in range(1, 20):
+        core.tick(t)
+    assert core.motors() == (500, 500)
+    # a long main-loop pass: no tick for 5 ms, then STOP and the reverse command in it
+    send(core, 2, gen.Stop(), 24)
+    stopped = 24
+    send(core, 3, gen.SetDrive(left=-500, right=-500), 24)
+    t = 24
+    while core.motors() == (0, 0):
+        t += 1
+        core.tick(t)
+        assert t < 100
+    assert t - stopped >= gen.DEFAULT_REVERSE_COAST_MS, t - stopped
+
+
+def test_a_reversal_commanded_within_a_pass_coasts_the_whole_interval(core) -> None:
+    """Likewise for a reversal without a ramp, which reaches zero as the SET_DRIVE is handled."""
+    send(core, 0, gen.SetConfig(link_timeout_ms=5000, accel_limit=0), 0)
+    send(core, 1, gen.SetDrive(left=500, right=500), 0)
+    for t in range(1, 20):
+        core.tick(t)
+    send(core, 2, gen.SetDrive(left=-500, right=-500), 23)
+    assert core.motors() == (0, 0)
+    t = 23
+    while core.motors() == (0, 0):
+        t += 1
+        core.tick(t)
+        assert t < 100
+    assert t - 23 >= gen.DEFAULT_REVERSE_COAST_MS, t - 23

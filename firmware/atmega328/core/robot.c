@@ -72,11 +72,35 @@ static void output(void)
     board_unlock(state);
 }
 
+/* One NACK credit back every PROTO_DEFAULT_NACK_INTERVAL_MS, up to NACK_BURST. */
+static void refill_nacks(uint16_t elapsed)
+{
+    uint16_t ms = robot.nack_ms + elapsed;
+    while (ms >= PROTO_DEFAULT_NACK_INTERVAL_MS && robot.nack_credit < NACK_BURST) {
+        ms -= PROTO_DEFAULT_NACK_INTERVAL_MS;
+        robot.nack_credit++;
+    }
+    robot.nack_ms = robot.nack_credit < NACK_BURST ? (uint8_t)ms : 0;
+}
+
+/* The ms since the last call (the NACK budget refilled for them): what the drive may use of
+ * them. Called at every tick, and wherever the drive state changes between ticks (STOP, a new
+ * SET_DRIVE), so that a coast interval started there is counted from then, not from the last
+ * tick before it (the fuzzer's finding: STOP after a long pass coasted 6 ms, not 10). */
+static uint16_t advance(void)
+{
+    uint16_t elapsed = (uint16_t)(robot.now_ms - robot.last_tick_ms);
+    robot.last_tick_ms = robot.now_ms;
+    refill_nacks(elapsed);
+    return elapsed;
+}
+
 static void stop(void)
 {
     uint8_t state = board_lock();
     link.armed = 0;
     board_unlock(state);
+    advance();
     drive_stop(&robot.drive);
     output();
 }
@@ -113,7 +137,7 @@ static void on_set_drive(const struct frame *f)
     link_heard(&link, robot.now_ms);
     board_unlock(state);
     drive_command(&robot.drive, m.left, m.right);
-    drive_tick(&robot.drive, 0);
+    drive_tick(&robot.drive, advance());
     output();
     send_ack(f->seq, PROTO_ACK_RESULT_APPLIED);
 }
@@ -276,23 +300,10 @@ void robot_rx_byte(uint8_t byte, uint32_t now_ms)
         send_nack(robot.parser.last_seq, PROTO_ERROR_BAD_CRC);
 }
 
-/* One NACK credit back every PROTO_DEFAULT_NACK_INTERVAL_MS, up to NACK_BURST. */
-static void refill_nacks(uint16_t elapsed)
-{
-    uint16_t ms = robot.nack_ms + elapsed;
-    while (ms >= PROTO_DEFAULT_NACK_INTERVAL_MS && robot.nack_credit < NACK_BURST) {
-        ms -= PROTO_DEFAULT_NACK_INTERVAL_MS;
-        robot.nack_credit++;
-    }
-    robot.nack_ms = robot.nack_credit < NACK_BURST ? (uint8_t)ms : 0;
-}
-
 void robot_tick(uint32_t now_ms)
 {
     robot.now_ms = now_ms;
-    uint16_t elapsed = (uint16_t)(now_ms - robot.last_tick_ms);
-    robot.last_tick_ms = now_ms;
-    refill_nacks(elapsed);
+    uint16_t elapsed = advance();
     /* a partial frame whose next byte is overdue is dropped: checked every tick, so the 8-bit
      * difference is read long before it could wrap */
     if (robot.parser.state != FRAME_WAIT_START &&
