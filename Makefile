@@ -10,7 +10,7 @@ DATA ?= $(abspath ../shared/data)
 # tests and benchmarks find the Middlebury scenes through this variable
 export STEREO_SERVO_DATA ?= $(if $(wildcard $(DATA)/middlebury/index.json),$(DATA),)
 
-.PHONY: demo test lint bench venv system-deps browser-deps platformio protocol firmware flash mutants clean
+.PHONY: demo test lint bench venv system-deps browser-deps platformio protocol firmware flash mutants fuzz clean
 
 $(BIN)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -56,12 +56,21 @@ bench: venv
 	$(BIN)/python bench/link.py
 	$(BIN)/python bench/servo.py
 	$(BIN)/python bench/view.py
+	$(MAKE) fuzz
 	$(MAKE) mutants
 
-# firmware mutation testing (firmware/atmega328/mutants.toml): every mutant must be killed; it
-# takes several minutes, so it runs with the benchmarks, not in make test
+# firmware mutation testing (firmware/atmega328/mutants.toml): an unmutated control must pass,
+# then every mutant must be killed by a behaviour test or be argued equivalent (tools/mutate.py);
+# it takes tens of minutes, so it runs with the benchmarks, not in make test
 mutants: venv system-deps
-	$(BIN)/python tools/mutate.py
+	@mkdir -p $(OUT)
+	$(BIN)/python tools/mutate.py --table $(OUT)/mutants.md
+
+# libFuzzer (clang, ASan + UBSan) on the frame parser and the firmware core, FUZZ_S seconds each
+# from the committed corpus (make test runs a few seconds of it: tests/firmware/test_libfuzzer.py)
+FUZZ_S ?= 300
+fuzz: venv system-deps
+	$(BIN)/python tools/fuzz.py --seconds $(FUZZ_S) --out build/fuzz
 
 # regenerate everything derived from protocol/spec.toml (tests fail while it is stale)
 protocol: venv

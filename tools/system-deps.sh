@@ -2,7 +2,8 @@
 # Install the Debian packages the firmware build and tests need, when missing and run as root.
 set -euo pipefail
 packages=(gcc make gcc-avr avr-libc binutils-avr simavr libsimavr-dev avrdude
-          arduino-core-avr) # arduino-core-avr: the Uno's bootloader (optiboot) for the simulated Uno
+          arduino-core-avr # the Uno's bootloader (optiboot) for the simulated Uno
+          clang)           # libFuzzer with ASan and UBSan (tools/fuzz.py)
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
