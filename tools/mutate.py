@@ -14,10 +14,12 @@ it does here. What counts (pytest's JUnit report, the failure's exception type):
     error, any other exception (FileNotFoundError, BuildFailed, CalledProcessError, ...): the test
     is deselected and the run goes on, and the report says so.
 A mutant whose find text is not in its file exactly once is an error (exit 2), as is a control
-that fails. expect = "equivalent" (with why = the argument) must survive; a mutant that does not
-build is INVALID. --quick runs a mutant's killed_by tests first and the whole set only when they
-do not kill it (a kill is a kill whatever else runs; a survivor has faced every test the control
-passed). Exit 0 when every mutant met its expectation, 1 when one did not, 2 on an error."""
+that fails. expect = "equivalent" (with why = the argument) must survive, and so must expect =
+"survives" (a race no test can hit yet: reported as a known survivor, not as equivalent); a mutant
+that does not build is INVALID. --quick runs a mutant's killed_by tests first and the whole set
+only when they do not kill it (a kill is a kill whatever else runs; a survivor has faced every
+test the control passed). Exit 0 when every mutant met its expectation, 1 when one did not, 2 on
+an error."""
 
 from __future__ import annotations
 
@@ -68,10 +70,12 @@ def load(path: Path = MUTANTS, root: Path = ROOT) -> list[Mutant]:
         if not re.fullmatch(r"[a-z0-9]+(-[a-z0-9]+)*", mutant.name) or mutant.name in names:
             raise ValueError(f"mutant {mutant.name!r}: name not kebab-case or used twice")
         names.add(mutant.name)
-        if mutant.expect not in ("killed", "equivalent"):
-            raise ValueError(f"mutant {mutant.name}: expect must be killed or equivalent")
-        if mutant.expect == "equivalent" and not mutant.why.strip():
-            raise ValueError(f"mutant {mutant.name}: an equivalent mutant needs its argument (why)")
+        if mutant.expect not in ("killed", "equivalent", "survives"):
+            raise ValueError(f"mutant {mutant.name}: expect must be killed, equivalent or "
+                             "survives")
+        if mutant.expect != "killed" and not mutant.why.strip():
+            raise ValueError(f"mutant {mutant.name}: a mutant expected to survive needs its "
+                             "argument (why)")
         if mutant.find == mutant.replace:
             raise ValueError(f"mutant {mutant.name}: replace is the find text")
         text = (root / mutant.file).read_text()
@@ -294,6 +298,11 @@ def _run(mutants: list[Mutant], tests: list[str], args: argparse.Namespace) -> i
             ok = result == "survived"
             shown = "equivalent (survived)" if ok else f"NOT EQUIVALENT: {result}"
             by = by or m.why.strip().split("\n")[0][:100]
+        elif m.expect == "survives":  # argued in the file: not equivalent, no test hits it yet
+            ok = result == "survived"
+            shown = ("SURVIVED (known, not equivalent)" if ok
+                     else f"{result}, not the known survivor")
+            by = by or " ".join(m.why.split())[:100]
         else:
             ok = result == "killed"
             shown = {"killed": "killed", "survived": "SURVIVED", "invalid": "INVALID"}[result]
@@ -306,7 +315,8 @@ def _run(mutants: list[Mutant], tests: list[str], args: argparse.Namespace) -> i
     table = "\n".join(rows)
     summary = (f"{len(mutants)} mutants: {killed} killed, "
                f"{sum('equivalent (survived)' in r for r in rows)} equivalent, "
-               f"{bad} not as expected")
+               f"{sum('(known, not equivalent)' in r for r in rows)} known survivors "
+               f"(not equivalent), {bad} not as expected")
     print(f"\n{head}\n\n{table}\n\n{summary}")
     if args.table:
         args.table.write_text(f"{head}\n\n{table}\n\n{summary}\n")
