@@ -2,7 +2,7 @@
 core: tests/c/fuzz_parser.c and tests/c/fuzz_core.c, from the committed corpus under tests/c/corpus
 (the parser's also seeded with protocol/vectors.json).
 
-    python tools/fuzz.py [--seconds S] [--only parser|core]
+    python tools/fuzz.py [--seconds S] [--only parser|core] [--out DIR] [--coverage]
 
 Prints each target's figures (runs, edges covered, features, corpus) and exits 1 on a finding
 (the input is kept under build/fuzz/<target>/ as crash-*, to become a corpus file and a test),
@@ -96,11 +96,36 @@ def run(target: str, seconds: float, out_dir: Path) -> Result:
                   last[-1] else 0, float(secs.group(1)) if secs else 0.0, findings, log)
 
 
+def coverage(target: str, corpus: list[Path], out_dir: Path) -> str:
+    """llvm-cov's report (lines, branches) of the target's sources over the inputs in corpus,
+    run once each by a build with source-based coverage."""
+    clang, cov, prof = (shutil.which(t) for t in ("clang", "llvm-cov", "llvm-profdata"))
+    if not (clang and cov and prof):
+        raise FuzzError("clang, llvm-cov and llvm-profdata are needed for coverage")
+    exe = out_dir / f"cover-{target}"
+    sources = [str(p) for p in TARGETS[target][1:]]
+    r = subprocess.run([clang, "-O0", "-std=gnu11", "-fsanitize=fuzzer",
+                        "-fprofile-instr-generate", "-fcoverage-mapping", f"-I{PROTOCOL}",
+                        str(TARGETS[target][0]), *sources, "-o", str(exe)],
+                       capture_output=True, text=True)
+    if r.returncode:
+        raise FuzzError(f"coverage build of {target} failed: {r.stderr[-800:]}")
+    raw = out_dir / f"{target}.profraw"
+    subprocess.run([str(exe), "-runs=0", *map(str, corpus)], capture_output=True, text=True,
+                   env={"LLVM_PROFILE_FILE": str(raw)})
+    data = out_dir / f"{target}.profdata"
+    subprocess.run([prof, "merge", "-sparse", str(raw), "-o", str(data)], check=True)
+    return subprocess.run([cov, "report", str(exe), f"-instr-profile={data}", *sources],
+                          capture_output=True, text=True, check=True).stdout
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seconds", type=float, default=60.0, help="per target (default 60)")
     ap.add_argument("--only", choices=sorted(TARGETS), help="one target")
     ap.add_argument("--out", type=Path, default=None, help="work folder (default a temporary one)")
+    ap.add_argument("--coverage", action="store_true",
+                    help="then report line and branch coverage of the sources over the corpus")
     args = ap.parse_args(argv)
     out = args.out or Path(tempfile.mkdtemp(prefix="stereo-servo-fuzz-"))
     out.mkdir(parents=True, exist_ok=True)
@@ -118,6 +143,10 @@ def main(argv: list[str] | None = None) -> int:
             print(f"  finding: {f}")
         if not r.ok and not r.findings:
             print(r.log[-3000:])
+        if args.coverage:
+            committed = ROOT / "tests" / "c" / "corpus" / target
+            dirs = [out / target / "corpus", *([committed] if committed.exists() else [])]
+            print(coverage(target, dirs, out), flush=True)
     return 1 if bad else 0
 
 
