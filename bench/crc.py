@@ -142,7 +142,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     frames = {"SET_DRIVE": encode_frame(7, *pack(gen.SetDrive(left=500, right=-500))),
               "STATUS": encode_frame(7, *pack(gen.Status(123456, 500, -500, 4, 1, 1000, 3, 2,
-                                                         250, 400, 0, 0)))}
+                                                         250, 400, 0, 0, 0)))}
     print(f"# {args.trials} corruptions per cell; {os.cpu_count()} CPUs, load "
           f"{os.getloadavg()[0]:.2f}; numba, one thread")
     print("| CRC | model | " + " | ".join(f"{k} ({len(v)} B)" for k, v in frames.items())
