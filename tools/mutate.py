@@ -103,10 +103,13 @@ BASE: Path | None = None  # the snapshot (main sets it)
 
 
 def copy_tree(dest: Path) -> None:
-    """A copy of the snapshot, and a link to this checkout's .venv."""
+    """A copy of the snapshot in dest/tree, a link to this checkout's .venv in it, and next to
+    it a link to this checkout's ../shared (the PlatformIO snapshot, the data), as here."""
     assert BASE is not None
-    shutil.copytree(BASE, dest, dirs_exist_ok=True, symlinks=True)
-    (dest / ".venv").symlink_to((ROOT / ".venv").resolve())
+    shutil.copytree(BASE, dest / "tree", symlinks=True)
+    (dest / "tree" / ".venv").symlink_to((ROOT / ".venv").resolve())
+    if (ROOT.parent / "shared").exists():
+        (dest / "shared").symlink_to((ROOT.parent / "shared").resolve())
 
 
 @dataclass
@@ -207,8 +210,8 @@ def control(tests: list[str]) -> tuple[list[Outcome], list[str], float]:
     t0 = time.monotonic()
     flaky: list[str] = []
     with tempfile.TemporaryDirectory(prefix="mutant-control-") as d:
-        tree = Path(d)
-        copy_tree(tree)
+        copy_tree(Path(d))
+        tree = Path(d) / "tree"
         while True:
             outcomes, stdout = pytest_run(tree, tests, flaky)
             bad = next((o for o in outcomes if o.kind in ("kill", "other-failure", "error")),
@@ -232,8 +235,8 @@ def run_mutant(m: Mutant, tests: list[str], quick: bool,
     t0 = time.monotonic()
     notes: list[str] = []
     with tempfile.TemporaryDirectory(prefix=f"mutant-{m.name}-") as d:
-        tree = Path(d)
-        copy_tree(tree)
+        copy_tree(Path(d))
+        tree = Path(d) / "tree"
         target = tree / m.file
         target.write_text(target.read_text().replace(m.find, m.replace, 1))
         for extra in ([], ["TEST_HANG=1"]):
