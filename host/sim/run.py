@@ -5,6 +5,7 @@ link and the servo, all on one simulated clock."""
 from __future__ import annotations
 
 import contextlib
+import functools
 import math
 import random
 from collections.abc import Iterator
@@ -17,8 +18,9 @@ from host.emulator.lockstep import LockstepLine
 from host.link.client import RobotLink
 from host.servo.controller import ControlConfig
 from host.servo.loop import Servo
+from host.servo_run import Rules, run_servo
 from host.sim.chessboard import calibrate_camera
-from host.sim.faults import WorldFaults
+from host.sim.faults import CameraFaults, WorldFaults
 from host.sim.renderer import Renderer
 from host.sim.source import SimSource
 from host.sim.world import Box, World
@@ -40,6 +42,7 @@ class Setup:
     retries: int = 8
     reply_timeout_s: float = 0.1  # the link's default; on the simulated clock
     board: Any = None  # a running Board (simavr ELF, simulated Uno) instead of the native core
+    calib_seed: int | None = None  # seed of the chessboard calibration (None: seed)
 
 
 @dataclass
@@ -57,11 +60,12 @@ class SimRun:
 
     def run(self, seconds: float, settle: float | None = 1.0) -> None:
         """Steps until `seconds` of simulated time, the servo stops itself, or it has held
-        for `settle` seconds."""
-        while self.source.t < seconds and not self.servo.stop_reason:
-            self.step()
-            if settle and self.servo.held_for(settle):
-                return
+        for `settle` seconds (host.servo_run's rules)."""
+        if self.source.t >= seconds or self.servo.stop_reason:
+            return
+        run_servo(self.servo, Rules(settle_s=settle or 0.0, duration_s=seconds - self.source.t),
+                  self.source.clock, lambda: self.world.robot.z_m,
+                  each=lambda row: self.depths.append(self.world.robot.z_m))
 
     def depth_error_m(self) -> float:
         """The robot's true depth minus its target object's true depth (m)."""
@@ -88,7 +92,8 @@ def simulation(setup: Setup = Setup(), reference: bool = True) -> Iterator[SimRu
                    rng=random.Random(setup.seed)) as link:
         geometry = world.geometry
         if any(faults.camera.distortion):  # rectify as a user would: with a calibration
-            calib = calibrate_camera(world, faults.camera, setup.seed)
+            seed = setup.seed if setup.calib_seed is None else setup.calib_seed
+            calib = _calibration(setup.size, faults.camera.distortion, seed)
             source.rectify = Rectifier(calib)
             geometry = calib.geometry
         servo = Servo(source, link, setup.params, geometry, setup.control, clock=source.clock)
@@ -96,6 +101,13 @@ def simulation(setup: Setup = Setup(), reference: bool = True) -> Iterator[SimRu
         if reference:
             servo.reference()
         yield run
+
+
+@functools.lru_cache(maxsize=32)
+def _calibration(size: tuple[int, int], distortion: tuple[float, float], seed: int) -> Any:
+    """The simulated camera's chessboard calibration, which depends on its size, lenses and
+    seed alone: computed once a process for each (trials share a few cameras)."""
+    return calibrate_camera(World.for_size(*size), CameraFaults(distortion=distortion), seed)
 
 
 def truth_target_error_m(run: SimRun) -> float:
