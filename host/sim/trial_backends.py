@@ -14,12 +14,15 @@ from host.errors import HostError
 
 def one_thread() -> None:
     """A trial computes on one thread: the workers are the parallelism, and the result cannot
-    depend on how many threads a machine has."""
+    depend on how many threads a machine or a backend gives it (BLAS's thread count changes the
+    last bits of the chessboard calibration; Ray sets OMP_NUM_THREADS=1 in its workers)."""
     import cv2
     import numba
+    from threadpoolctl import threadpool_limits
 
     cv2.setNumThreads(1)
     numba.set_num_threads(1)
+    threadpool_limits(1)
 
 
 def _run(job: tuple[Callable[[Any], Any], Any]) -> Any:

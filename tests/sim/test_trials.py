@@ -188,10 +188,11 @@ def _loopback_only() -> list[str]:
 
 def test_a_trial_on_ray_is_the_trial_run_alone(tmp_path) -> None:
     """--trial-index reproduces a trial whichever backend ran it: Ray (a local cluster in a
-    loopback-only namespace) and this process give the same bytes."""
+    loopback-only namespace) and one process give the same bytes (also the calibration of the
+    trial's lenses, whose last bits depend on BLAS's thread count)."""
     pytest.importorskip("ray", reason="Ray is not installed (pip install 'stereo-servo[ray]')")
     prefix = _loopback_only()
-    plan = ["--trials", "40", "--seed", "5", "--nominal", "--trial-index", "37"]
+    plan = ["--trials", "40", "--seed", "5", "--trial-index", "37"]  # faulty: lenses too
     env = os.environ | {"RAY_USAGE_STATS_ENABLED": "0"}
     alone = subprocess.run(_host(*plan, "--workers", "1", "--json", str(tmp_path / "a.json")),
                            capture_output=True, text=True, env=env, timeout=600)
