@@ -56,6 +56,7 @@ bench: venv
 	$(BIN)/python bench/link.py
 	$(BIN)/python bench/servo.py
 	$(BIN)/python bench/view.py
+	$(BIN)/python bench/trials.py
 	$(MAKE) fuzz
 	$(MAKE) mutants
 

@@ -78,7 +78,7 @@ def test_frames_of_another_spec_are_reported(far_end: FarEnd) -> None:
 
 
 def test_an_emulator_garbling_every_frame_is_not_called_silent() -> None:
-    with PtyService(Emulator(Faults(corrupt=0.3, seed=1))) as service:
+    with PtyService(Emulator(Faults(corrupt=0.5, seed=1))) as service:
         assert "only garbled frames arrived" in _handshake_error(service.path, 0.8)
 
 

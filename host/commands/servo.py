@@ -6,13 +6,13 @@ from __future__ import annotations
 import argparse
 import contextlib
 import math
+import re
 import sys
 import time
 from pathlib import Path
 
 from host.camera.calibration import Calibration, Geometry
 from host.camera.open import add_camera_options, open_source, parse_size
-from host.camera.source import CameraError
 from host.commands.options import (
     COUNT,
     FRACTION,
@@ -27,11 +27,12 @@ from host.commands.options import (
 from host.commands.servo_outcome import outcome
 from host.commands.view import add_view_option, open_view
 from host.errors import HostError, NotReached
-from host.files import check_output
+from host.files import check_folder, check_output
 from host.link.client import RobotLink
 from host.servo.controller import ControlConfig
 from host.servo.loop import Servo
 from host.servo.report import plot_run, write_csv
+from host.servo_run import NOT_SETTLED, Rules, run_servo
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -47,7 +48,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="--robot uno: the board's flash, as `host emulate --uno --flash FILE` "
                         "and an upload left it (default %(default)s)")
     p.add_argument("--log", type=Path, metavar="run.csv", help="write the run's log")
-    p.add_argument("--plot", type=Path, metavar="run.png", help="plot trajectory and commands")
+    p.add_argument("--plot", type=Path, metavar="run.png",
+                   help="plot trajectory and commands (with --trials: the campaign's summary)")
     p.add_argument("--duration", type=POSITIVE, metavar="S", help="stop after S seconds")
     p.add_argument("--settle", type=NON_NEGATIVE, default=1.0, metavar="S",
                    help="end after holding at the target this long (0: run on)")
@@ -72,14 +74,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=SEED, default=0, help="sim: seed of the world and its faults")
     p.add_argument("--trials", type=COUNT, metavar="N",
                    help="sim: N randomized runs of the faulty world, then their summary")
-    p.add_argument("--json", type=Path, metavar="trials.json",
-                   help="with --trials: write every trial and the summary")
-    p.add_argument("--nominal", action="store_true",
-                   help="with --trials: the world without faults")
-    p.add_argument("--workers", type=COUNT, default=2, help="with --trials: processes")
-    p.add_argument("--trial-index", type=int_range(0, 1_000_000), action="append",
-                   metavar="I", help="with --trials: run only trial I of them (repeatable), "
-                   "to reproduce one")
+    add_trial_options(p)
     p.add_argument("--drop", type=FRACTION, default=0.0, help="sim: byte drop probability")
     p.add_argument("--corrupt", type=FRACTION, default=0.0,
                    help="sim: byte corruption probability")
@@ -90,6 +85,29 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     add_matcher_options(p)
     add_view_option(p)
     p.set_defaults(run=run)
+
+
+TRIAL_OPTIONS = ("json", "csv", "nominal", "trial_index", "ray", "resume")
+
+
+def add_trial_options(p: argparse.ArgumentParser) -> None:
+    """The options that go with --trials (checked in run: without --trials each is refused)."""
+    p.add_argument("--json", type=Path, metavar="trials.json",
+                   help="with --trials: every trial and the summary, written as they finish")
+    p.add_argument("--csv", type=Path, metavar="trials.csv",
+                   help="with --trials: a row per trial, appended as each finishes")
+    p.add_argument("--resume", action="store_true",
+                   help="with --trials and --json: keep the trials that file has, run the rest")
+    p.add_argument("--nominal", action="store_true",
+                   help="with --trials: the world without faults")
+    p.add_argument("--workers", type=COUNT, default=2,
+                   help="with --trials: processes (or --ray's local CPUs)")
+    p.add_argument("--ray", nargs="?", const="local", metavar="ADDRESS",
+                   help="with --trials: run them as Ray tasks, on a local cluster bound to "
+                        "127.0.0.1 or on the one at ADDRESS (host:port, ray://host:port, auto)")
+    p.add_argument("--trial-index", type=int_range(0, 1_000_000), action="append",
+                   metavar="I", help="with --trials: run only trial I of them (repeatable), "
+                   "to reproduce one; the same whichever backend ran it")
 
 
 class _Status:
@@ -127,10 +145,11 @@ def run(args: argparse.Namespace) -> int:
         check_output(args.plot, "png", "--plot")
     if args.min_duty > args.max_duty:
         raise HostError(f"--min-duty {args.min_duty} exceeds --max-duty {args.max_duty}")
-    trial_only = [o for o, v in (("--json", args.json), ("--nominal", args.nominal),
-                                 ("--trial-index", args.trial_index)) if v]
+    trial_only = ["--" + o.replace("_", "-") for o in TRIAL_OPTIONS if getattr(args, o)]
     if trial_only and not args.trials:
         raise HostError(f"{trial_only[0]} goes with --trials N: without it nothing reads it")
+    if args.trials:
+        _check_trial_args(args)
     if args.sim or args.camera == "sim":
         if args.port not in (None, "emulator"):
             raise HostError("--camera sim needs --port emulator (the simulated robot)")
@@ -158,6 +177,22 @@ def run(args: argparse.Namespace) -> int:
         return _servo(args, servo, geometry, None, time.monotonic)
 
 
+def _check_trial_args(args) -> None:
+    if args.json:
+        if args.json.is_dir():
+            raise HostError(f"--json {args.json}: is a folder (name a file)")
+        check_folder(args.json.parent, "--json", target=args.json)
+    if args.csv:
+        check_output(args.csv, "csv", "--csv")
+    if args.resume and not args.json:
+        raise HostError("--resume needs --json FILE: the trials finished are read from it")
+    if args.ray is not None and not (args.ray in ("local", "auto")
+                                     or args.ray.startswith("ray://")
+                                     or re.fullmatch(r"[\w.\-]+:\d+", args.ray)):
+        raise HostError(f"--ray ADDRESS must be host:port, ray://host:port or auto, got "
+                        f"{args.ray!r}")
+
+
 def _link_faults(args):
     from host.emulator.emulator import Faults
 
@@ -180,11 +215,12 @@ def _run_sim(args) -> int:
 
     params = params_from_args(args)
     if args.trials:
-        from host.sim.trials import run_trials
+        from host.sim.campaign import run_trials
 
+        ray = None if args.ray is None else True if args.ray == "local" else args.ray
         return run_trials(args.trials, args.seed, parse_size(args.size), params, args.json,
-                          workers=args.workers, nominal=args.nominal,
-                          indices=args.trial_index)
+                          workers=args.workers, nominal=args.nominal, indices=args.trial_index,
+                          csv_path=args.csv, ray=ray, resume=args.resume, plot_path=args.plot)
     faults = WorldFaults()
     if args.faults:
         faults = random_faults(np.random.default_rng(args.seed), 1.2)
@@ -222,33 +258,33 @@ def _servo(args, servo, geometry, world, clock) -> int:
         return _run_servo(args, servo, geometry, world, clock)
 
 
+SIM_LIMIT_S = 60.0  # a simulated run without --duration that has not settled by then failed
+
+
 def _run_servo(args, servo, geometry, world, clock) -> int:
     target = servo.reference()
     z = geometry.depth_m(target.disparity)
     print(f"target: nearest object at disparity {target.disparity:.2f} px ({z:.3f} m), "
           f"{target.area} px; tolerance {servo.tolerance_m * 100:g} cm", file=sys.stderr)
     status = _Status()
-    t0 = clock()
+
+    def each(row) -> None:
+        for note in servo.notes + servo.link.notes:
+            print(f"note: {note}", file=sys.stderr)
+        servo.notes.clear()
+        servo.link.notes.clear()
+        status.show(row)
+
+    rules = Rules(settle_s=args.settle, duration_s=args.duration,
+                  limit_s=SIM_LIMIT_S if world is not None and args.duration is None else None,
+                  camera_end_ok=args.camera.startswith("replay:"))
     try:
-        while True:
-            try:
-                row = servo.step(world.robot.z_m if world else math.nan)
-            except CameraError:
-                if not args.camera.startswith("replay:"):
-                    raise
-                break  # the end of a replay ends the run; outcome() tells how it went
-            for note in servo.notes:
-                print(f"note: {note}", file=sys.stderr)
-            servo.notes.clear()
-            status.show(row)
-            if row.phase == "stop":  # the servo's own safe stop, or STOP pressed in the view
-                break
-            if args.duration is not None and clock() - t0 >= args.duration:
-                break
-            if args.settle and servo.held_for(args.settle):
-                break
-            if world is not None and args.duration is None and clock() - t0 > 60:
-                raise NotReached("the simulated robot did not settle within 60 s")
+        # ends at the servo's own safe stop, STOP pressed in the view, --duration, --settle,
+        # a replay's end (outcome() tells how it went) or, simulated, the time limit
+        end = run_servo(servo, rules, clock, (lambda: world.robot.z_m) if world else
+                        (lambda: math.nan), each=each)
+        if end.how == NOT_SETTLED:
+            raise NotReached(f"the simulated robot did not settle within {SIM_LIMIT_S:g} s")
     finally:
         status.done()
         if servo.rows:

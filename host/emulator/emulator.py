@@ -1,11 +1,11 @@
 """The robot on a PC: the firmware's core with a simulated clock, a 115200-baud line, link
-faults, and a pseudo-terminal that any serial program can open as if it were the robot."""
+faults, and a pseudo-terminal that any serial program can open as if it were the robot (the
+simulation talks to it in-process instead, host.emulator.lockstep)."""
 
 from __future__ import annotations
 
 import contextlib
 import os
-import random
 import select
 import threading
 import time
@@ -13,21 +13,52 @@ import tty
 from collections import deque
 from dataclasses import dataclass
 
+import numpy as np
+
 from host.emulator.core import FirmwareCore
 from host.link import protocol_gen as gen
 
 BYTES_PER_MS = gen.BAUD / 10 / 1000  # 8N1: ten bits a byte
+TO_ROBOT, TO_HOST = 0, 1  # the line's two directions
 
 
 @dataclass(frozen=True)
 class Faults:
-    """Link faults, applied to every byte in both directions. Rates are probabilities per byte."""
+    """Link faults, applied to every byte in both directions. Rates are probabilities per byte;
+    whether the n-th byte of a direction is hit is drawn from (seed, direction, n) alone, so a
+    resend does not change which later bytes are hit. At reset_at_ms the board resets (its
+    motors stop, it forgets its configuration and session) with reset_cause; boot_lost: the
+    BOOT frame it sends then never reaches the host."""
 
     drop: float = 0.0
     corrupt: float = 0.0
     delay_ms: float = 0.0
     silent_after_ms: float | None = None  # then the line is cut both ways
     seed: int = 0
+    reset_at_ms: float | None = None
+    reset_cause: int = gen.ResetCause.WATCHDOG
+    boot_lost: bool = False
+
+
+class ByteDraws:
+    """Counter-based draws for the line's faults: (drop, corrupt, xor) of byte n of a direction
+    depend on (seed, direction, n) only, computed a block of positions at a time."""
+
+    BLOCK = 4096
+
+    def __init__(self, seed: int) -> None:
+        self.seed = seed
+        self._blocks: dict[tuple[int, int], np.ndarray] = {}
+
+    def at(self, direction: int, n: int) -> tuple[float, float, int]:
+        key = (direction, n // self.BLOCK)
+        block = self._blocks.get(key)
+        if block is None:
+            block = np.random.default_rng([self.seed, *key]).random((self.BLOCK, 3))
+            self._blocks = {key: block, **{k: v for k, v in self._blocks.items()
+                                           if k[0] != direction}}
+        drop, corrupt, xor = block[n % self.BLOCK]
+        return float(drop), float(corrupt), 1 + int(xor * 255)
 
 
 class Emulator:
@@ -43,7 +74,9 @@ class Emulator:
         self.faults = faults
         self.line_rate = line_rate
         self.now_ms = 0.0
-        self._rng = random.Random(faults.seed)
+        self._draws = ByteDraws(faults.seed)
+        self._sent = [0, 0]  # bytes that entered the line, per direction
+        self.resets = 0  # resets of the fault model (Faults.reset_at_ms) so far
         self._core = FirmwareCore(reset_cause, 0)
         self._inbound: deque[tuple[float, int]] = deque()
         self._outbound: deque[tuple[float, int]] = deque()
@@ -60,15 +93,33 @@ class Emulator:
         after = self.faults.silent_after_ms
         return after is not None and self.now_ms >= after
 
-    def _faulty(self, data: bytes) -> list[int]:
+    def _faulty(self, data: bytes, direction: int) -> list[int]:
+        f = self.faults
+        n0 = self._sent[direction]
+        self._sent[direction] += len(data)
+        if not (f.drop or f.corrupt):
+            return list(data)
         out = []
-        for b in data:
-            if self.faults.drop and self._rng.random() < self.faults.drop:
+        for i, b in enumerate(data):
+            drop, corrupt, xor = self._draws.at(direction, n0 + i)
+            if drop < f.drop:
                 continue
-            if self.faults.corrupt and self._rng.random() < self.faults.corrupt:
-                b ^= self._rng.randrange(1, 256)
+            if corrupt < f.corrupt:
+                b ^= xor
             out.append(b)
         return out
+
+    def _reset_due(self) -> None:
+        """The fault model's reset: the core starts again at this time, the bytes on their way
+        to it and in its transmit buffer lost; its BOOT frame lost too when boot_lost."""
+        f = self.faults
+        if f.reset_at_ms is None or self.resets or self.now_ms < f.reset_at_ms:
+            return
+        self.resets += 1
+        self._inbound.clear()
+        self._core = FirmwareCore(f.reset_cause, int(self.now_ms))  # a board just started
+        if f.boot_lost:
+            self._core.take_tx()
 
     def receive(self, data: bytes) -> None:
         """Bytes the host wrote, starting on the line now."""
@@ -77,7 +128,7 @@ class Emulator:
                 self._record.write(data)
             if self.silent:
                 return
-            for b in self._faulty(data):
+            for b in self._faulty(data, TO_ROBOT):
                 start = max(self.now_ms, self._line_free_ms) if self.line_rate else self.now_ms
                 self._line_free_ms = start + (1 / BYTES_PER_MS if self.line_rate else 0.0)
                 self._inbound.append((self._line_free_ms + self.faults.delay_ms, b))
@@ -98,7 +149,7 @@ class Emulator:
         data = self._core.take_tx()
         if self.silent:
             return
-        for b in self._faulty(data):
+        for b in self._faulty(data, TO_HOST):
             if self.line_rate:
                 self._tx_free_ms = max(self.now_ms, self._tx_free_ms) + 1 / BYTES_PER_MS
                 due = self._tx_free_ms
@@ -118,6 +169,7 @@ class Emulator:
             end = self.now_ms + ms
             while self.now_ms < end:
                 self.now_ms = min(end, float(int(self.now_ms) + 1))
+                self._reset_due()
                 self._deliver()
                 if int(self.now_ms) != self._ticked_ms:
                     self._ticked_ms = int(self.now_ms)

@@ -5,26 +5,34 @@
         robot.keepalive()                      # call often: resends the drive every keepalive_s
     # leaving the block sends STOP, also on an exception or Ctrl-C
 
-Every failure is a LinkError with a one-line message.
+Every failure is a LinkError with a one-line message. Before driving, every status_s the link
+asks the robot's STATUS: a reset (also one whose BOOT frame was lost), a stop of its own for
+link loss, or a state that is not the one commanded is seen there. After any reset it learns
+of, the link says HELLO again and re-applies its configuration, then raises RobotReset.
+Timeouts are measured on the port's clock: the wall clock for a serial port, the simulated
+clock for the simulation's in-process line.
 """
 
 from __future__ import annotations
 
 import random
-import time
 from collections.abc import Callable
 from typing import Any
-
-import serial
 
 from host.errors import HostError
 from host.link import protocol_gen as gen
 from host.link.frame import FrameDecoder, encode_frame
 from host.link.messages import ProtocolError, pack, unpack
+from host.link.port import Port, PortError, SerialPort
 
 
 class LinkError(HostError):
     """The serial link or the robot failed; the message is one line."""
+
+
+class RobotReset(LinkError):
+    """The robot reset during the session; the link has said HELLO again, re-applied its
+    configuration and sent STOP: the robot stands."""
 
 
 _RESET_EXPLAINED = {
@@ -48,12 +56,17 @@ def explain_reset(cause: int) -> str:
 
 
 class RobotLink:
-    """A session with the robot over a serial port (a device path or a pyserial URL)."""
+    """A session with the robot over a serial port (a device path or a pyserial URL) or an
+    open Port (host.link.port); rng numbers the frames and draws the HELLO nonces (seed it for
+    a repeatable simulation)."""
 
-    def __init__(self, port: str, *, baud: int = gen.BAUD, reply_timeout_s: float = 0.1,
+    def __init__(self, port: str | Port, *, baud: int = gen.BAUD, reply_timeout_s: float = 0.1,
                  retries: int = 8, handshake_s: float = 3.0, keepalive_s: float = 0.08,
-                 expected_hash: int = gen.SCHEMA_HASH) -> None:
-        self.port = port
+                 status_s: float = 0.5, expected_hash: int = gen.SCHEMA_HASH,
+                 rng: random.Random | None = None) -> None:
+        self.port = port if isinstance(port, str) else getattr(port, "name", "the robot's line")
+        self._port_arg = port
+        self.status_s = status_s  # how often drive() first checks the robot's STATUS; 0: never
         self.baud = baud
         self.reply_timeout_s = reply_timeout_s
         self.retries = retries
@@ -65,45 +78,60 @@ class RobotLink:
         self.received_bytes = 0  # every byte read, frame or not (the handshake reports it)
         self.resends = 0  # commands sent again after silence or a CRC NACK
         self.nacks = 0  # NACKs received
-        self.resets = 0  # BOOTs (resets) the robot reported during the session
-        self._ser: serial.Serial | None = None
+        self.resets = 0  # resets the robot went through during the session (BOOT or STATUS)
+        self.link_losses = 0  # stops of the robot's own for link loss, seen in STATUS
+        self.notes: list[str] = []  # what the link saw and the user should know
+        self._ser: Port | None = None
         self._dec = FrameDecoder()
+        self._rng = rng or random.Random()
         # commands and polls are numbered from separate counters (docs/protocol.md, "Sequence
         # numbers and resends"), so polls can never bring a command's SEQ round again
-        self._seq = random.randrange(256)
-        self._poll_seq = random.randrange(256)
+        self._seq = self._rng.randrange(256)
+        self._poll_seq = self._rng.randrange(256)
         self._last_command = b""  # the last command frame written, for judging DUPLICATE
         self._last_drive: tuple[int, int] | None = None
         self._last_drive_sent = 0.0
+        self._config: tuple[int, int] | None = None  # (link timeout, accel limit) last set
+        self._uptime: tuple[int, float] | None = None  # robot's uptime (ms) at the last STATUS
+        # and when (s) on this host's clock
+        self._status_t = 0.0
+        self._resyncing = False
 
     # ----------------------------------------------------------------------------- port I/O
 
     def open(self) -> RobotLink:
-        try:
-            self._ser = serial.serial_for_url(self.port, baudrate=self.baud, timeout=0.005,
-                                              write_timeout=1.0)
-        except (serial.SerialException, OSError, ValueError) as e:
-            raise LinkError(f"cannot open {self.port}: {_reason(e)}") from None
+        if isinstance(self._port_arg, str):
+            try:
+                self._ser = SerialPort(self._port_arg, self.baud)
+            except PortError as e:
+                raise LinkError(f"cannot open {self.port}: {e}") from None
+        else:
+            self._ser = self._port_arg
         try:
             self.hello = self._handshake()
+            self._learn_uptime()
         except BaseException:
             self.close()  # a failed handshake leaves the port closed (and an Uno's DTR off)
             raise
         return self
 
+    def _now(self) -> float:
+        assert self._ser is not None
+        return self._ser.now()
+
     def _write(self, data: bytes) -> None:
         assert self._ser is not None
         try:
             self._ser.write(data)
-        except (serial.SerialException, OSError) as e:
-            raise LinkError(f"lost the serial port {self.port}: {_reason(e)}") from None
+        except PortError as e:
+            raise LinkError(f"lost the serial port {self.port}: {e}") from None
 
-    def _messages(self) -> list[Any]:
+    def _messages(self, wait_s: float = 0.005) -> list[Any]:
         assert self._ser is not None
         try:
-            data = self._ser.read(max(1, self._ser.in_waiting))
-        except (serial.SerialException, OSError) as e:
-            raise LinkError(f"lost the serial port {self.port}: {_reason(e)}") from None
+            data = self._ser.read(wait_s)
+        except PortError as e:
+            raise LinkError(f"lost the serial port {self.port}: {e}") from None
         self.received_bytes += len(data)
         out = []
         for f in self._dec.feed(data):
@@ -111,28 +139,49 @@ class RobotLink:
                 msg = unpack(f.id, f.payload)
             except ProtocolError:
                 continue  # a frame from a robot of another spec; the handshake says so
-            if isinstance(msg, gen.Boot) and self.hello is not None:
-                self.resets += 1
-                raise LinkError(f"the robot reset during the session: "
-                                f"{explain_reset(msg.reset_cause)}")
+            if isinstance(msg, gen.Boot) and self.hello is not None and not self._resyncing:
+                raise self._resync(f"the robot reset during the session: "
+                                   f"{explain_reset(msg.reset_cause)}")
             out.append(msg)
         return out
 
     def _await(self, match: Callable[[Any], bool], timeout_s: float) -> Any:
-        deadline = time.monotonic() + timeout_s
-        while time.monotonic() < deadline:
-            for msg in self._messages():
+        deadline = self._now() + timeout_s
+        while (now := self._now()) < deadline:
+            for msg in self._messages(deadline - now):
                 if match(msg):
                     return msg
         return None
+
+    def _resync(self, why: str) -> RobotReset:
+        """After a reset: HELLO again and the configuration re-applied, so nothing is driven on
+        a board that forgot it; the RobotReset to raise (a LinkError if the robot is gone)."""
+        self.resets += 1
+        self._last_drive, self._last_command, self._uptime = None, b"", None
+        self._resyncing = True
+        try:
+            self.hello = self._handshake()
+            if self._config is not None:
+                self.set_config(*self._config)
+            self.stop()  # what it did since the reset was driven on a board that had forgotten
+            self._learn_uptime()
+        finally:
+            self._resyncing = False
+        return RobotReset(why)
+
+    def _learn_uptime(self) -> None:
+        """After a handshake: the robot has been up for 0 ms at least by now, what later STATUS
+        uptimes are judged against."""
+        self._status_t = self._now()
+        self._uptime = (0, self._status_t)
 
     # ----------------------------------------------------------------------------- protocol
 
     def _handshake(self) -> Any:
         # An Uno resets when the port opens; its bootloader needs a moment, so HELLO is resent
         # until the reply with this nonce comes or handshake_s runs out.
-        nonce = random.getrandbits(32)
-        deadline = time.monotonic() + self.handshake_s
+        nonce = self._rng.getrandbits(32)
+        deadline = self._now() + self.handshake_s
         dec = self._dec
         good0, bad0 = dec.good_frames, dec.crc_errors + dec.framing_errors
         bytes0 = self.received_bytes
@@ -143,9 +192,9 @@ class RobotLink:
             read[1] += isinstance(m, gen.Hello)  # our own HELLO: the line echoes
             return isinstance(m, gen.HelloReply) and m.nonce == nonce
 
-        while time.monotonic() < deadline:
+        while self._now() < deadline:
             self._write(encode_frame(self._next_poll_seq(), *pack(gen.Hello(nonce=nonce))))
-            reply = self._await(is_reply, min(0.25, max(0.0, deadline - time.monotonic())))
+            reply = self._await(is_reply, min(0.25, max(0.0, deadline - self._now())))
             if reply is None:
                 continue
             if reply.schema_hash != self.expected_hash:
@@ -206,10 +255,52 @@ class RobotLink:
         return ack
 
     def drive(self, left: int, right: int) -> None:
-        """Set both motors' duty in permille (-1000..1000, positive = forward)."""
+        """Set both motors' duty in permille (-1000..1000, positive = forward). The robot's
+        STATUS is checked first (check_health) every status_s, and when no drive was sent for
+        the robot's link timeout."""
+        now = self._now()
+        timeout_s = (self._config[0] if self._config else self.hello.link_timeout_ms) / 1000
+        if self.status_s and (now - self._status_t >= self.status_s or self._last_drive
+                              and now - self._last_drive_sent >= timeout_s):
+            self.check_health()  # when due, and when the robot may have stopped for link loss
         self.command(gen.SetDrive(left=int(left), right=int(right)))
         self._last_drive = (int(left), int(right))
-        self._last_drive_sent = time.monotonic()
+        self._last_drive_sent = self._now()
+
+    def check_health(self) -> None:
+        """Ask STATUS and judge it against what this host did: a reset (uptime back, another
+        cause, the configuration back at its defaults) re-handshakes and raises RobotReset; a
+        stop for link loss is counted and noted (the next SET_DRIVE drives again); a robot that
+        drives after STOP raises LinkError. A robot that does not answer is left to the next
+        command to report."""
+        self._status_t = self._now()
+        try:
+            s = self.status()
+        except RobotReset:
+            raise
+        except LinkError as e:
+            if "did not answer" in str(e):
+                return
+            raise
+        now = self._now()
+        least = None
+        if self._uptime is not None:  # what the uptime must have reached, with some slack for
+            # the reply's time on the line and the robot's crystal
+            elapsed_ms = (now - self._uptime[1]) * 1000
+            least = self._uptime[0] + int(elapsed_ms * 0.98) - 50
+        why = health_problem(s, self.hello, least, self._config)
+        if why:
+            raise self._resync(f"the robot reset during the session without its BOOT frame "
+                               f"({why}): {explain_reset(s.reset_cause)}")
+        self._uptime = (s.uptime_ms, now)
+        driving = bool(s.flags & gen.StatusFlag.DRIVING)
+        if self._last_drive is not None and s.flags & gen.StatusFlag.LINK_LOST:
+            self.link_losses += 1
+            self.notes.append(f"the robot stopped itself for link loss (no SET_DRIVE within "
+                              f"its {s.link_timeout_ms} ms) before {s.uptime_ms} ms of uptime")
+        elif self._last_drive is None and driving:
+            raise LinkError(f"the robot drives at {s.left} {s.right} though this host stopped "
+                            f"it")
 
     def stop(self) -> None:
         self.command(gen.Stop())
@@ -219,12 +310,13 @@ class RobotLink:
         """Send the drive command again when none was sent for keepalive_s, well inside the
         firmware's link-loss timeout (only SET_DRIVE restarts it, not status polls); does
         nothing while stopped."""
-        if self._last_drive and time.monotonic() - self._last_drive_sent >= self.keepalive_s:
+        if self._last_drive and self._now() - self._last_drive_sent >= self.keepalive_s:
             self.drive(*self._last_drive)
 
     def set_config(self, link_timeout_ms: int,
                    accel_limit: int = gen.DEFAULT_ACCEL_LIMIT) -> None:
         self.command(gen.SetConfig(link_timeout_ms=link_timeout_ms, accel_limit=accel_limit))
+        self._config = (link_timeout_ms, accel_limit)
 
     def status(self) -> Any:
         """The robot's STATUS message."""
@@ -251,13 +343,20 @@ class RobotLink:
         self.close()
 
 
-def _reason(e: BaseException) -> str:
-    text = str(e).strip() or type(e).__name__
-    if "No such file" in text or "could not open port" in text and "[Errno 2]" in text:
-        return "no such device"
-    if "Permission denied" in text or "[Errno 13]" in text:
-        return "permission denied (add yourself to the dialout group)"
-    return text.splitlines()[0]
+def health_problem(s: Any, hello: Any, least_uptime_ms: int | None,
+                   config: tuple[int, int] | None) -> str:
+    """Why a STATUS shows a reset the host was not told of, or "": the uptime is below the least
+    it must have reached by now (modulo its 32-bit wrap), the reset cause is not the one of the
+    handshake, or the link timeout and ramp are not what this host set."""
+    least = least_uptime_ms
+    if least is not None and 0 < (least - s.uptime_ms) % (1 << 32) < 1 << 31:
+        return f"uptime {s.uptime_ms} ms where it must have reached {least} ms"
+    if s.reset_cause != hello.reset_cause:
+        return f"reset cause {s.reset_cause}, {hello.reset_cause} at the handshake"
+    if config is not None and (s.link_timeout_ms, s.accel_limit) != config:
+        return (f"link timeout {s.link_timeout_ms} ms and ramp {s.accel_limit}, set to "
+                f"{config[0]} ms and {config[1]}")
+    return ""
 
 
 def _seen(nbytes: int, good: int, bad: int, unreadable: int, echoed: int, baud: int) -> str:

@@ -1,23 +1,26 @@
-"""One simulated servo run: the world with its faults, the renderer, the firmware's core on a pty
-as the robot (or a board running the real AVR binary), the link and the servo, in lockstep
-simulated time."""
+"""One simulated servo run: the world with its faults, the renderer, the firmware's core as the
+robot on an in-process line (or a board running the real AVR binary on a pty, in real time), the
+link and the servo, all on one simulated clock."""
 
 from __future__ import annotations
 
 import contextlib
-import dataclasses
+import functools
 import math
+import random
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
 from host.camera.calibration import Rectifier
-from host.emulator.emulator import Emulator, PtyService
+from host.emulator.emulator import Emulator
+from host.emulator.lockstep import LockstepLine
 from host.link.client import RobotLink
 from host.servo.controller import ControlConfig
 from host.servo.loop import Servo
+from host.servo_run import Rules, run_servo
 from host.sim.chessboard import calibrate_camera
-from host.sim.faults import WorldFaults
+from host.sim.faults import CameraFaults, WorldFaults
 from host.sim.renderer import Renderer
 from host.sim.source import SimSource
 from host.sim.world import Box, World
@@ -37,7 +40,9 @@ class Setup:
     params: MatcherParams = MatcherParams(block_size=9, num_disparities=48, border="clip")
     control: ControlConfig = ControlConfig()
     retries: int = 8
+    reply_timeout_s: float = 0.1  # the link's default; on the simulated clock
     board: Any = None  # a running Board (simavr ELF, simulated Uno) instead of the native core
+    calib_seed: int | None = None  # seed of the chessboard calibration (None: seed)
 
 
 @dataclass
@@ -55,11 +60,12 @@ class SimRun:
 
     def run(self, seconds: float, settle: float | None = 1.0) -> None:
         """Steps until `seconds` of simulated time, the servo stops itself, or it has held
-        for `settle` seconds."""
-        while self.source.t < seconds and not self.servo.stop_reason:
-            self.step()
-            if settle and self.servo.held_for(settle):
-                return
+        for `settle` seconds (host.servo_run's rules)."""
+        if self.source.t >= seconds or self.servo.stop_reason:
+            return
+        run_servo(self.servo, Rules(settle_s=settle or 0.0, duration_s=seconds - self.source.t),
+                  self.source.clock, lambda: self.world.robot.z_m,
+                  each=lambda row: self.depths.append(self.world.robot.z_m))
 
     def depth_error_m(self) -> float:
         """The robot's true depth minus its target object's true depth (m)."""
@@ -73,23 +79,21 @@ def simulation(setup: Setup = Setup(), reference: bool = True) -> Iterator[SimRu
     world = World.for_size(*setup.size, seed=setup.seed, motor_faults=faults.motor, **kw)
     r = world.robot
     r.z_m, r.x_m, r.theta = setup.start_z_m, setup.start_x_m, setup.start_theta
-    # lockstep time moves only between frames, so a line delay is felt as a later command
-    link_faults = dataclasses.replace(faults.link, delay_ms=0.0)
     renderer = Renderer(world, faults.camera, seed=setup.seed)
-    if setup.board is None:
-        emulator = Emulator(link_faults, line_rate=False)
-        board_cm: Any = PtyService(emulator, realtime=False)
-    else:  # a real-time board: advance() waits on the wall clock
-        emulator = setup.board
-        board_cm = contextlib.nullcontext(setup.board)
-    with board_cm as service, \
-            RobotLink(service.path, retries=setup.retries, reply_timeout_s=0.2) as link:
-        source = SimSource(world, emulator, setup.fps, renderer=renderer, events=faults.events,
-                           latency_ms=faults.motor.latency_ms + faults.link.delay_ms,
-                           seed=setup.seed)
+    # the native core: bytes at line rate on the simulated clock; or a board running the AVR
+    # binary in real time on a pty (its advance() waits on the wall clock)
+    emulator: Any = Emulator(faults.link) if setup.board is None else setup.board
+    source = SimSource(world, emulator, setup.fps, renderer=renderer, events=faults.events,
+                       latency_ms=faults.motor.latency_ms, seed=setup.seed)
+    port: Any = setup.board.path if setup.board else LockstepLine(emulator, source.run_ms,
+                                                                   lambda: source.now_ms)
+    reply_timeout_s = max(0.2, setup.reply_timeout_s) if setup.board else setup.reply_timeout_s
+    with RobotLink(port, retries=setup.retries, reply_timeout_s=reply_timeout_s,
+                   rng=random.Random(setup.seed)) as link:
         geometry = world.geometry
         if any(faults.camera.distortion):  # rectify as a user would: with a calibration
-            calib = calibrate_camera(world, faults.camera, setup.seed)
+            seed = setup.seed if setup.calib_seed is None else setup.calib_seed
+            calib = _calibration(setup.size, faults.camera.distortion, seed)
             source.rectify = Rectifier(calib)
             geometry = calib.geometry
         servo = Servo(source, link, setup.params, geometry, setup.control, clock=source.clock)
@@ -97,6 +101,13 @@ def simulation(setup: Setup = Setup(), reference: bool = True) -> Iterator[SimRu
         if reference:
             servo.reference()
         yield run
+
+
+@functools.lru_cache(maxsize=32)
+def _calibration(size: tuple[int, int], distortion: tuple[float, float], seed: int) -> Any:
+    """The simulated camera's chessboard calibration, which depends on its size, lenses and
+    seed alone: computed once a process for each (trials share a few cameras)."""
+    return calibrate_camera(World.for_size(*size), CameraFaults(distortion=distortion), seed)
 
 
 def truth_target_error_m(run: SimRun) -> float:

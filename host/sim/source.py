@@ -26,7 +26,10 @@ class SimSource(StereoSource):
     """Frames at fps; between frames the world and the board advance in 1 ms steps, the robot
     driven by the duties the firmware applies, latency_ms later. The first reference_frames
     frames show the scene without the robot (the reference phase). The right view is captured
-    skew_ms after the left; a dropped frame never arrives (the next one comes a period later)."""
+    skew_ms after the left; a dropped frame never arrives (the next one comes a period later).
+    Captures keep the camera's own schedule: time the host spends waiting on the link (which
+    runs the same clock, host.emulator.lockstep) does not shift it, and a capture the host was
+    too busy to take is overwritten by the next."""
 
     def __init__(self, world: World, board: Board, fps: float = 30.0,
                  reference_frames: int = 5, renderer: Renderer | None = None,
@@ -40,6 +43,7 @@ class SimSource(StereoSource):
         self.index = 0
         self.now_ms = 0
         self.dropped = 0
+        self._due_ms = 0  # the left capture of the frame being read
         self._pending: deque[tuple[int, tuple[int, int]]] = deque()
         self._applied = (0, 0)
         self._occluded_until = -1.0
@@ -87,10 +91,16 @@ class SimSource(StereoSource):
         cam = self.renderer.camera
         skew = int(round(cam.skew_ms))
         if self.index:
-            self.run_ms(period - skew)
+            self._due_ms += period
+            while self._due_ms < self.now_ms:
+                self._due_ms += period
+            self.run_ms(self._due_ms - self.now_ms)
             while cam.drop and self.rng.random() < cam.drop:
                 self.dropped += 1
+                self._due_ms += period
                 self.run_ms(period)
+        else:
+            self._due_ms = self.now_ms
         with_robot = self.index >= self.reference_frames
         vel = self.renderer.image_velocity()
         blur = (vel[0] * cam.exposure_ms / 1000, vel[1] * cam.exposure_ms / 1000)

@@ -2,35 +2,36 @@
 
 Each trial: the target box at a random depth, the robot at a random start 0.4-3.0 m from the
 camera (in front of or behind the target), every fault of host.sim.faults at a random size
-(none with nominal=True), run in lockstep simulated time until the servo holds (after the last
-scene event), stops itself, or 45 s pass. Outcomes:
+(none with nominal=True), one of CAMERAS cameras of the campaign (its lenses and their
+chessboard calibration), now and then a reset of the robot's board (its BOOT frame sometimes
+lost), run on the simulated clock by host.servo_run until the servo holds (after the last scene
+event), stops itself, or 45 s pass. Trial i of seed s depends on (s, i) alone. Outcomes:
 
-    held    holding, within 2 cm of the object's true depth (or within the tolerance the servo
-            announced it had to widen to)
-    missed  holding, but farther than that from the object's true depth
-    stopped a safe stop, with its reason (target vanished, marker lost, link error ...)
-    unsafe  the robot hit the object or the camera, its marker left the view while the motors
-            drove, or the firmware drove on with no valid observation for longer than the
-            stale limit
+    held         holding, within 2 cm of the object's true depth (or within the tolerance the
+                 servo announced it had to widen to)
+    missed       holding, but farther than that from the object's true depth
+    stopped      a safe stop, with its reason (target vanished, marker lost, link error ...)
+    not settled  neither held nor stopped within 45 s: not a safe stop, not a success
+    unsafe       the robot hit the object or the camera, its marker left the view while the
+                 motors drove, the motors drove with no valid observation for longer than the
+                 stale limit, or on a marker depth farther than TRUTH_GAP_M + TRUTH_GAP_REL x
+                 depth from the robot's true depth
 """
 
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
-import multiprocessing
-import sys
-from dataclasses import asdict, dataclass
-from pathlib import Path
+from dataclasses import dataclass
 
 import numpy as np
 
 from host.camera.source import CameraError
-from host.errors import HostError
-from host.files import write_text_atomic
+from host.link import protocol_gen as gen
 from host.link.client import LinkError
 from host.servo.controller import ControlConfig
+from host.servo.loop import LogRow
+from host.servo_run import HELD, NOT_SETTLED, UNSAFE, Rules, run_servo
 from host.sim.faults import WorldFaults, random_faults
 from host.sim.run import Setup, SimRun, simulation
 from host.sim.world import Box
@@ -40,6 +41,9 @@ MAX_S = 45.0
 SETTLE_S = 1.0
 LOST_GIVE_UP_S = 5.0
 HOLD_WITHIN_M = 0.02
+CAMERAS = 16  # cameras (lenses, calibration) of a campaign; trial i uses camera i % CAMERAS
+RESET_P, BOOT_LOST_P = 0.02, 0.02  # chance of a board reset with its BOOT frame, without it
+TRUTH_GAP_M, TRUTH_GAP_REL = 0.10, 0.05  # driving on a depth this far from the truth is unsafe
 
 
 @dataclass
@@ -48,13 +52,15 @@ class Trial:
     start_m: float
     target_m: float  # the object's true depth at the start
     faults: str  # a short description
-    outcome: str  # held / missed / stopped / unsafe
+    events: list[str]  # the kinds of event drawn (scene events, silence, resets)
+    outcome: str  # held / missed / stopped / not settled / unsafe
     reason: str
     error_m: float  # robot's true depth minus the object's, at the end
     tolerance_m: float  # as the servo announced it
     overshoot_m: float
     time_to_hold_s: float
     sim_s: float
+    truth_gap_m: float  # largest |marker depth driven on - true depth|
 
 
 def trial_setup(seed: int, index: int, size: tuple[int, int], params: MatcherParams,
@@ -67,22 +73,46 @@ def trial_setup(seed: int, index: int, size: tuple[int, int], params: MatcherPar
     x = float(rng.uniform(-0.04, 0.04)) * start
     theta = math.radians(float(rng.uniform(-4, 4)))
     faults = WorldFaults() if nominal else random_faults(rng, target_z)
-    if not nominal:  # lenses from a stream of their own: the other faults stay as they were
-        lens = np.random.default_rng([seed, index, 1]).uniform(-0.1, 0.04, 2)
+    trial_seed = int(rng.integers(1 << 30))
+    calib_seed = None
+    if not nominal:  # lenses and resets from streams of their own: the rest stays as it was
+        camera = index % CAMERAS
+        lens = np.random.default_rng([seed, camera, 1]).uniform(-0.1, 0.04, 2)
         faults = dataclasses.replace(faults, camera=dataclasses.replace(
             faults.camera, distortion=(float(lens[0]), float(lens[1]))))
-    return Setup(size, start, x, theta, boxes, faults, seed=int(rng.integers(1 << 30)),
-                 params=params.replace(colour=False), control=ControlConfig())
+        calib_seed = seed * CAMERAS + camera
+        faults = dataclasses.replace(faults, link=_reset(np.random.default_rng([seed, index, 2]),
+                                                         faults.link))
+    return Setup(size, start, x, theta, boxes, faults, seed=trial_seed,
+                 params=params.replace(colour=False), control=ControlConfig(),
+                 calib_seed=calib_seed)
+
+
+def _reset(rng: np.random.Generator, link):
+    """Now and then a reset of the board between 2 and 8 s (watchdog or brown-out), its BOOT
+    frame lost in half of them."""
+    u = float(rng.random())
+    if u >= RESET_P + BOOT_LOST_P:
+        return link
+    cause = gen.ResetCause.WATCHDOG if rng.random() < 0.5 else gen.ResetCause.BROWN_OUT
+    return dataclasses.replace(link, reset_at_ms=float(rng.uniform(2000, 8000)),
+                               reset_cause=int(cause), boot_lost=u < BOOT_LOST_P)
+
+
+def event_kinds(f: WorldFaults) -> list[str]:
+    kinds = [e.kind for e in f.events]
+    if f.link.silent_after_ms is not None:
+        kinds.append("silent")
+    if f.link.reset_at_ms is not None:
+        kinds.append("reset, BOOT lost" if f.link.boot_lost else "reset")
+    return kinds
 
 
 def _describe(f: WorldFaults) -> str:
     m, c = f.motor, f.camera
     parts = [f"gain {m.gain[0]:.2f}/{m.gain[1]:.2f}", f"latency {m.latency_ms:.0f} ms",
              f"skew {c.skew_ms:.0f} ms", f"drop {c.drop:.2f}"]
-    parts += [e.kind for e in f.events]
-    if f.link.silent_after_ms is not None:
-        parts.append("silent")
-    return ", ".join(parts)
+    return ", ".join(parts + event_kinds(f))
 
 
 def _unsafe(sim: SimRun, last_valid: float, stale_s: float) -> str:
@@ -104,6 +134,31 @@ def _unsafe(sim: SimRun, last_valid: float, stale_s: float) -> str:
     return ""
 
 
+def truth_gap(row: LogRow) -> float:
+    """|marker depth - true depth| of a step whose command drove on its observation, else 0."""
+    used = math.isfinite(row.depth_m) and not row.reason and (row.left or row.right)
+    return abs(row.depth_m - row.truth_depth_m) if used else 0.0
+
+
+class Judge:
+    """The trial's watch over a run (host.servo_run's watch): a reason the run is unsafe."""
+
+    def __init__(self, sim: SimRun) -> None:
+        self.sim = sim
+        self.last_valid = 0.0
+        self.worst_gap = 0.0
+
+    def __call__(self, row: LogRow) -> str:
+        if math.isfinite(row.depth_m) and not row.reason:
+            self.last_valid = row.t
+        gap = truth_gap(row)
+        self.worst_gap = max(self.worst_gap, gap)
+        if gap > TRUTH_GAP_M + TRUTH_GAP_REL * row.truth_depth_m:
+            return (f"drove on a marker depth of {row.depth_m:.2f} m with the robot at "
+                    f"{row.truth_depth_m:.2f} m")
+        return _unsafe(self.sim, self.last_valid, self.sim.servo.stale_s)
+
+
 def run_trial(job: tuple[int, int, tuple[int, int], MatcherParams, bool]) -> Trial:
     seed, index, size, params, nominal = job
     setup = trial_setup(seed, index, size, params, nominal)
@@ -112,38 +167,28 @@ def run_trial(job: tuple[int, int, tuple[int, int], MatcherParams, bool]) -> Tri
     outcome, reason, tol = "stopped", "", math.nan
     with simulation(setup, reference=False) as sim:
         servo = sim.servo
+        judge = Judge(sim)
         try:
             servo.reference()
-            last_valid, lost_since = 0.0, None
-            while sim.source.t < MAX_S:
-                sim.step()
-                row = servo.rows[-1]
-                if math.isfinite(row.depth_m) and not row.reason:
-                    last_valid = row.t
-                why = _unsafe(sim, last_valid, servo.stale_s)
-                if why:
-                    outcome, reason = "unsafe", why
-                    break
-                if servo.stop_reason:
-                    reason = servo.stop_reason
-                    break
-                lost_since = (lost_since or row.t) if row.phase == "lost" else None
-                if lost_since is not None and row.t - lost_since > LOST_GIVE_UP_S:
-                    reason = f"marker lost for {LOST_GIVE_UP_S:g} s"
-                    break
-                if servo.held_for(SETTLE_S) and sim.source.t > last_event + 2.5:
-                    break
-            else:
-                reason = f"did not settle in {MAX_S:g} s"
+            rules = Rules(settle_s=SETTLE_S, limit_s=MAX_S, lost_s=LOST_GIVE_UP_S,
+                          hold_from_s=last_event + 2.5)
+            end = run_servo(servo, rules, sim.source.clock, lambda: sim.world.robot.z_m,
+                            watch=judge,
+                            each=lambda row: sim.depths.append(sim.world.robot.z_m))
             tol = servo.tolerance_m
+            reason = end.reason
+            if end.how == UNSAFE:
+                outcome = "unsafe"
+            elif end.how == NOT_SETTLED:
+                outcome = "not settled"
+            elif end.how == HELD:
+                err = sim.depth_error_m()
+                within = abs(err) <= max(HOLD_WITHIN_M, tol if math.isfinite(tol) else 0.0)
+                outcome = "held" if within else "missed"
+            else:
+                reason = reason or servo.outcome()[1]
         except (LinkError, CameraError) as e:
             reason = f"link: {e}" if isinstance(e, LinkError) else str(e)
-        if outcome != "unsafe" and not reason:
-            held, why = servo.outcome()
-            err = sim.depth_error_m()
-            within = abs(err) <= max(HOLD_WITHIN_M, tol if math.isfinite(tol) else 0.0)
-            outcome = ("held" if within else "missed") if held == "held" else "stopped"
-            reason = why
         err = sim.depth_error_m() if sim.world.boxes else math.nan
         z = sim.depths or [setup.start_z_m]
         final = sim.world.nearest_box().z_m if sim.world.boxes else target0
@@ -155,66 +200,6 @@ def run_trial(job: tuple[int, int, tuple[int, int], MatcherParams, bool]) -> Tri
             while k > 0 and rows[k - 1].phase == "hold":
                 k -= 1
             t_hold = rows[k].t - rows[0].t
-        return Trial(index, setup.start_z_m, target0, _describe(setup.faults), outcome, reason,
-                     err, tol, max(0.0, over), t_hold, sim.source.t)
-
-
-def _pct(values: list[float], q: float) -> float:
-    return float(np.percentile(values, q)) if values else math.nan
-
-
-def summary(trials: list[Trial]) -> dict:
-    held = [t for t in trials if t.outcome == "held"]
-    errs = [abs(t.error_m) * 100 for t in trials if t.outcome in ("held", "missed")]
-    times = [t.time_to_hold_s for t in trials if t.outcome in ("held", "missed")]
-    reasons: dict[str, int] = {}
-    for t in trials:
-        if t.outcome in ("stopped", "unsafe"):
-            key = f"{t.outcome}: {t.reason}"
-            reasons[key] = reasons.get(key, 0) + 1
-    return {"trials": len(trials), "held": len(held),
-            "missed": sum(t.outcome == "missed" for t in trials),
-            "stopped": sum(t.outcome == "stopped" for t in trials),
-            "unsafe": sum(t.outcome == "unsafe" for t in trials),
-            "hold_rate": len(held) / len(trials) if trials else math.nan,
-            "error_cm_p50": _pct(errs, 50), "error_cm_p95": _pct(errs, 95),
-            "error_cm_max": max(errs) if errs else math.nan,
-            "time_s_p50": _pct(times, 50), "time_s_p95": _pct(times, 95),
-            "reasons": reasons}
-
-
-def run_trials(n: int, seed: int, size: tuple[int, int], params: MatcherParams,
-               json_path: Path | None = None, workers: int = 2, nominal: bool = False,
-               out=sys.stdout, indices: list[int] | None = None) -> int:
-    """Runs trials 0..n-1 (or only those of `indices`: trial i is the same whatever else
-    runs), prints each and the summary, optionally writes them as JSON."""
-    if indices and max(indices) >= n:
-        raise HostError(f"--trial-index {max(indices)} is not among the {n} trials")
-    jobs = [(seed, i, size, params, nominal) for i in (sorted(set(indices)) if indices
-                                                       else range(n))]
-    trials: list[Trial] = []
-    world = "nominal" if nominal else "faulty"
-    which = f"{len(jobs)} of {n}" if indices else f"{n}"
-    print(f"{which} trials of the {world} world at {size[0]}x{size[1]}, seed {seed}", file=out)
-    ctx = multiprocessing.get_context("spawn")
-    with ctx.Pool(max(1, min(workers, len(jobs)))) as pool:
-        for t in pool.imap(run_trial, jobs):
-            trials.append(t)
-            print(f"  {t.index:3d}  start {t.start_m:4.2f} m  target {t.target_m:4.2f} m  "
-                  f"{t.outcome:<7} err {t.error_m * 100:+6.2f} cm  overshoot "
-                  f"{t.overshoot_m * 100:5.1f} cm  hold at {t.time_to_hold_s:5.1f} s  "
-                  f"{t.reason}  [{t.faults}]", file=out, flush=True)
-    s = summary(trials)
-    print(f"held {s['held']}/{s['trials']} ({s['hold_rate']:.0%}), missed {s['missed']}, "
-          f"safe stops {s['stopped']}, unsafe {s['unsafe']}; |error| p50 "
-          f"{s['error_cm_p50']:.2f} cm, p95 {s['error_cm_p95']:.2f} cm, max "
-          f"{s['error_cm_max']:.2f} cm; time to hold p50 {s['time_s_p50']:.1f} s, p95 "
-          f"{s['time_s_p95']:.1f} s", file=out)
-    for k, v in s["reasons"].items():
-        print(f"  {v:3d} x {k}", file=out)
-    if json_path is not None:
-        write_text_atomic(json_path, json.dumps({"world": world, "seed": seed, "size": size,
-                                                 "summary": s,
-                                                 "trials": [asdict(t) for t in trials]},
-                                                indent=1) + "\n")
-    return 0
+        return Trial(index, setup.start_z_m, target0, _describe(setup.faults),
+                     event_kinds(setup.faults), outcome, reason, err, tol, max(0.0, over),
+                     t_hold, sim.source.t, judge.worst_gap)
