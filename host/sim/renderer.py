@@ -80,6 +80,7 @@ class Renderer:
         self._body_tex = random_texture(np.random.default_rng(seed + 1), 64, 64, 1.2, 45, 110)
         self._person_tex = random_texture(np.random.default_rng(seed + 2), 256, 256, 2.0, 50, 120)
         self.pitch_deg = 0.0  # the rig's pitch since it was calibrated (a knock)
+        self._last_noise = [-1, -1]  # the noise field each sensor got last
         self._row0 = 0  # rows of the canvas above the view's first (a pitched rig sees them)
         self.flicker: Flicker | None = None
         self._lens = [lens_maps(world, k1) for k1 in camera.distortion]
@@ -278,8 +279,13 @@ class Renderer:
             img = img * self.flicker.gains(t, side, img.shape[0])[:, None]
         cam = self.camera
         img = img * cam.gain[side] + cam.bias[side]
-        if self._noise is not None:
-            img += self._noise[int(self.rng.integers(len(self._noise)))]
+        if self._noise is not None:  # never the last field again: a live sensor never
+            # repeats its image exactly (a repeat is what a frozen one does)
+            k = int(self.rng.integers(len(self._noise)))
+            if k == self._last_noise[side]:
+                k = (k + 1) % len(self._noise)
+            self._last_noise[side] = k
+            img += self._noise[k]
         if cam.white:
             img = img[..., None] * np.asarray(cam.white[side], np.float32)
         lens = self._lens[side]
