@@ -17,7 +17,7 @@ from host.sim.faults import (
 )
 from host.sim.renderer import Renderer
 from host.sim.source import SimSource
-from host.sim.world import World
+from host.sim.world import Person, Robot, World
 
 
 class Board:
@@ -261,3 +261,14 @@ def test_a_decoy_shows_a_second_marker_at_its_depth() -> None:
     u, v, disp = source.world.marker_truth(d)
     assert f.left[int(round(v)), int(round(u))] < 60  # its dark disc
     assert f.right[int(round(v)), int(round(u - disp))] < 60
+
+
+def test_the_world_says_when_the_robot_bumps_into_someone() -> None:
+    world = World()
+    world.robot.z_m, world.robot.x_m = 1.0, 0.0
+    world.people = (Person(0.25, 1.05),)
+    assert world.bumped_into() == "a person"
+    world.people = (Person(0.35, 1.05),)  # 0.225 + 0.08 from its centre: clear
+    assert world.bumped_into() == ""
+    world.decoys = (Robot(x_m=0.1, z_m=1.0),)
+    assert world.bumped_into() == "another robot"
