@@ -272,3 +272,16 @@ def test_the_world_says_when_the_robot_bumps_into_someone() -> None:
     assert world.bumped_into() == ""
     world.decoys = (Robot(x_m=0.1, z_m=1.0),)
     assert world.bumped_into() == "another robot"
+
+
+def test_a_knock_leaves_the_scene_as_it_was_only_seen_from_elsewhere() -> None:
+    """The rows a pitched rig sees beyond the view are added without changing the view's own
+    (target boxes at 1.0-1.5 m: at 1.3 m a floor reaching lower once painted over the box)."""
+    from host.sim.world import Box
+
+    for z in (1.0, 1.3, 1.5):
+        world = World(seed=3, boxes=(Box(z, -0.50, -0.18, 0.38), Box(1.8, 0.22, 0.55, 0.30)))
+        r = Renderer(world, seed=3)
+        for side in (0, 1):
+            plain, padded = r._render_static(0)[side][0], r._render_static(16)[side][0]
+            assert np.abs(padded[16:16 + 240] - plain).max() < 0.01
