@@ -85,9 +85,9 @@ def test_no_frame_of_the_robot_phase_matches_more_than_one_band(monkeypatch) -> 
         remeasures = 0
         for _ in range(75):  # 2.5 s: two re-measures
             matched.clear()
-            before = sim.servo._target_history[:]
+            before = sim.servo.tracker.history[:]
             sim.step()
-            remeasures += sim.servo._target_history != before
+            remeasures += sim.servo.tracker.history != before
             assert sum(matched) < whole / 2  # a band of the map and the marker's window
     assert remeasures >= 2
 
