@@ -5,8 +5,10 @@ way the robot faces by what a short probe move does (a pure state machine, one c
              it is seen, for at most find_s (a robot started at 60 or 90 degrees shows its card
              edge-on)
     measure  standing, noise_frames sightings of its disparity (their spread is the noise)
-    probe    both wheels forward at probe_duty (raised by probe_step every probe_step_s) until
-             the marker has moved probe_m: its depth grew, the robot faces away from the camera,
+    probe    both wheels at probe_duty (raised by probe_step every probe_step_s), forward or
+             backward (direction: the way the robot must go if it faces away), until
+             the marker has moved probe_m (and well beyond its noise, on lines fitted through
+             the probe's sightings): its depth grew, the robot faces away from the camera,
              else toward it; nothing moved by probe_s: the run stops with that reason
 """
 
@@ -53,8 +55,8 @@ class Acquisition:
         self.facing_away: bool | None = None  # learnt by the probe (None: not yet)
         self.fault = ""  # why the run must end, "" if none
         self._t0: float | None = None  # when the phase began
-        self._origin: tuple[float, float] | None = None  # (z, x) where the probe began
-        self._spinning = False
+        self._track: list[tuple[float, float, float]] = []  # (t, z, x) in the probe
+        self.direction = 1  # the probe's: +1 forward, -1 backward (set by the servo)
 
     @property
     def done(self) -> bool:
@@ -63,8 +65,8 @@ class Acquisition:
     def update(self, t: float, position: tuple[float, float] | None,
                disparity: float | None, noise_m: float = 0.0) -> Order:
         """The frame at t: the robot's (depth, lateral) in m from the accepted sighting and
-        its disparity (px), or None when it was not seen; noise_m: the position's noise (the
-        probe's move must be well beyond it)."""
+        its disparity (px), or None when it was not seen; noise_m: a sighting's depth noise
+        (m, standard deviation; the probe's move must be well beyond it)."""
         if self._t0 is None:
             self._t0 = t
         if self.phase == FIND:
@@ -101,18 +103,24 @@ class Acquisition:
         cfg = self.cfg
         if position is None:
             return Order(0, 0, PROBE)  # not seen: stand until it is
-        if self._origin is None:
-            self._origin = position
-        dz, dx = position[0] - self._origin[0], position[1] - self._origin[1]
-        if math.hypot(dz, dx) >= max(cfg.probe_m, noise_m):
-            self.facing_away = dz > 0
-            self._begin(DONE, t)
-            return Order(0, 0, PROBE)
+        self._track.append((t, *position))
+        if len(self._track) >= 6:
+            # the move so far, from lines fitted through the probe's sightings: the fit's end
+            # points have about sqrt(12 / n) / 2 of one sighting's noise each
+            ts = np.array([p[0] for p in self._track])
+            span = ts[-1] - ts[0]
+            dz = float(np.polyfit(ts, [p[1] for p in self._track], 1)[0]) * span
+            dx = float(np.polyfit(ts, [p[2] for p in self._track], 1)[0]) * span
+            if math.hypot(dz, dx) >= max(cfg.probe_m, 3 * noise_m * math.sqrt(12 / len(ts))):
+                self.facing_away = (dz > 0) == (self.direction > 0)
+                self._begin(DONE, t)
+                return Order(0, 0, PROBE)
         if t - self._t0 > cfg.probe_s:
             self.fault = NOT_MOVED
             return Order(0, 0, PROBE)
         duty = min(cfg.max_probe_duty,
                    cfg.probe_duty + cfg.probe_step * int((t - self._t0) / cfg.probe_step_s))
+        duty *= self.direction
         return Order(duty, duty, PROBE)
 
     def noise_px(self) -> float:

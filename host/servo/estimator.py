@@ -5,9 +5,10 @@ motion is checked against the commands (a pure state machine, one call per frame
 State: depth z and lateral position x (m, camera frame: z along the optical axis, x to the
 right) and their rates, an alpha-beta filter on the sightings it accepts. The gate of a new
 sighting is the reach of the robot since the last accepted one: nothing while it was told to
-stand but a slow drift (a push, a slope) and the run-down of its last motion; at most
-max_speed_mps for the time it was told to move; always margin_m (the card's offset from the
-turn axis, blur) and sigmas times the sighting's own noise (depth noise grows as z^2). Its size
+stand but a slow drift (a push, a slope) and the run-down of its last motion; what its duties
+allow while it was told to move (max_speed_mps at full duty; a spin in place only the share
+unequal wheels turn into travel); always margin_m (the card's offset from the turn axis, blur)
+and sigmas times the sighting's own noise (depth noise grows as z^2). Its size
 must fit its disparity: the disc's vertical radius against the ratio learnt from the accepted
 sightings. A sighting outside the gate is not used; seen only outside it for outlier_stop_s,
 the run stops with that reason.
@@ -41,7 +42,8 @@ class EstimatorConfig:
     size_tolerance: float = 0.3  # the disc's radius against its disparity, relative
     outlier_stop_s: float = 2.0
     alpha: float = 0.5  # the filter's position and rate gains per accepted sighting
-    beta: float = 0.2
+    beta: float = 0.05
+    spin_share: float = 0.15  # of a spin's duty that unequal wheels may turn into travel
     settle_s: float = 0.3  # a command's effect shows this long after it (latency and lag)
     against_m: float = 0.025
     still_s: float = 1.0
@@ -78,7 +80,8 @@ class Estimator:
         self.rejected = 0  # sightings rejected since the last accepted one
         self.why = ""  # why the last sighting was rejected
         self._ratios: list[float] = []  # accepted radius / disparity
-        self._moving_s = 0.0  # time told to move since the last accepted sighting
+        self._moving_s = 0.0  # time told to go since the last accepted sighting
+        self._travel_m = 0.0  # the most its commands since then can have moved it
         self._cmd: tuple[float, int, int] | None = None  # the command in force since t
         self._outside_since: float | None = None
         self._segment: list[tuple[float, float, float]] = []  # (t, z, x) while driven one way
@@ -100,29 +103,35 @@ class Estimator:
         self._cmd = (t, left, right)
 
     def _account(self, t: float) -> None:
+        """Add the command in force since its time up to t to the travel allowed."""
         if self._cmd is None:
             return
         t0, left, right = self._cmd
-        if left or right:
-            self._moving_s += max(0.0, t - t0)
+        dt = max(0.0, t - t0)
+        ahead, spin = abs(left + right) / 2, abs(left - right) / 2
+        if ahead > spin:  # told to go (a spin in place goes nowhere)
+            self._moving_s += dt
+        # the most it can go: full speed at full duty, and unequal wheels' share of a spin
+        self._travel_m += self.cfg.max_speed_mps * (ahead + self.cfg.spin_share * spin) \
+            / 1000 * dt
         self._cmd = (t, left, right)
 
     def reach_m(self, t: float) -> float:
         """How far (m) the robot can have gone from its last accepted sighting by t: its
-        motion then running down, the time it was told to move since (and that motion running
-        down) at full speed, a drift, and the margin."""
+        motion then running down, what its commands since allow (and that motion running
+        down), a drift, and the margin."""
         assert self.state is not None
         cfg = self.cfg
         self._account(t)
         dt = max(0.0, t - self.state.t)
-        moved = self._moving_s + cfg.run_down_s if self._moving_s > 0 else 0.0
+        run_down = cfg.max_speed_mps * cfg.run_down_s if self._moving_s > 0 else 0.0
         speed = math.hypot(self.state.vz, self.state.vx)
-        return (cfg.margin_m + cfg.max_speed_mps * min(dt, moved) + cfg.drift_mps * dt
+        return (cfg.margin_m + self._travel_m + run_down + cfg.drift_mps * dt
                 + speed * min(dt, cfg.run_down_s))
 
     def predicted(self, t: float) -> tuple[float, float]:
         """(depth, lateral) in metres expected at t: the last accepted position moved on at the
-        filtered rate while the robot was told to move."""
+        filtered rate while the robot was told to go, and as its motion ran down."""
         assert self.state is not None
         s = self.state
         dt = min(max(0.0, t - s.t), self._moving_s + self.cfg.run_down_s)
@@ -174,14 +183,15 @@ class Estimator:
             a, b = self.cfg.alpha, self.cfg.beta
             rz, rx = z - zp, x - xp
             st.z, st.x = zp + a * rz, xp + a * rx
-            if dt > 0:
-                st.vz += b * rz / dt
-                st.vx += b * rx / dt
-                if dt > 0.5:  # too long apart: the rate is not known
-                    st.vz = st.vx = 0.0
+            if 0 < dt <= 0.5:  # further apart, the rate is not known
+                top = self.cfg.max_speed_mps
+                st.vz = max(-top, min(top, st.vz + b * rz / dt))
+                st.vx = max(-top, min(top, st.vx + b * rx / dt))
+            else:
+                st.vz = st.vx = 0.0
             st.t = s.t
         self._account(s.t)
-        self._moving_s = 0.0
+        self._moving_s = self._travel_m = 0.0
         self.rejected = 0
         self.why = ""
         self._outside_since = None

@@ -339,12 +339,13 @@ class Servo:
         """A frame of the acquisition: find, measure, probe."""
         acq = self.acquisition
         before = acq.phase
-        est = self.estimator
         noise_m = 0.0
-        if position is not None and est.state is not None:  # the filtered position
-            position = (est.state.z, est.state.x)
-            noise_m = 4 * est.sigma_px * position[0] ** 2 / (
+        if position is not None:
+            noise_m = self.estimator.sigma_px * position[0] ** 2 / (
                 self.geometry.focal_px * self.geometry.baseline_m)
+            if acq.phase == "measure":  # probe the way the robot must go if it faces away
+                assert self.controller is not None
+                acq.direction = 1 if position[0] < self.controller.target_m else -1
         order = acq.update(t, position, None if position is None else d, noise_m)
         if acq.fault:
             self.stop_reason = acq.fault
@@ -356,8 +357,7 @@ class Servo:
             assert self.controller is not None and acq.facing_away is not None
             self.controller.facing_away = acq.facing_away
             if not acq.facing_away:
-                self.notes.append("the probe move brought the robot nearer: it faces the "
-                                  "camera")
+                self.notes.append("the probe move showed that the robot faces the camera")
         return Command(order.left, order.right, order.phase, None)
 
     # ---------------------------------------------------------------------- the motion
