@@ -6,7 +6,9 @@ removed before the nearest object is sought. The nearest object is the connected
 largest disparity with at least min_area pixels, and its disparity is a robust statistic (the
 median) over that region, not a single pixel. During the run the whole map for the target's
 re-measure is matched a band of rows per frame (StripMap), so that no frame of the control loop
-pays for all of it.
+pays for all of it. The object's whole extent at its depth (object_extent) gives the lane's
+keep-out; the lane ahead of the robot is watched for a new object within the stopping
+distance (lane_window, match_window, lane_obstacle).
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from host.camera.calibration import Geometry
 from host.errors import HostError
 from host.stereo.matcher import compute_disparity, numba_threads
 from host.stereo.params import MatcherParams
@@ -224,3 +227,209 @@ class StripMap:
             self._map[max(y0, hy0):min(y1, hy1), x0:x1] = np.nan
         self.next += 1
         return None
+
+
+# ------------------------------------------------------------ the object as it is, the lane
+
+
+def object_extent(disp: np.ndarray, target: Target, tol_px: float | None = None,
+                  share: float = 0.5, gap_px: int = 4) -> Target:
+    """The target with its image region grown to the whole object at its depth.
+
+    nearest_object's region is the part of the object at the first threshold level (on a box
+    of uniform disparity, noise puts about half its pixels below it: 44 px wide where the box
+    is 104 px). Here the object's columns are those where at least `share` of the target's
+    rows hold a disparity within tol_px (default max(1, 6 %) of the target's) of the target's,
+    and its extent the run of such columns through the region (gaps up to gap_px bridged);
+    its rows likewise within those columns. A run that reaches the map's first or last valid
+    column (left of the search range nothing is matched) reaches the image's edge, so the
+    region then starts at column 0 (or ends at the last). The floor at the object's depth fills
+    only a few rows and does not widen it.
+
+    disp: the map (px, NaN invalid; the floor removed or not, the robot's region NaN); returns a
+    Target with the same disparity and spread, the whole object's bbox (x, y, w, h) and its
+    area in px (pixels within tol_px inside the bbox). Wiring: the keep-out comes from this
+    bbox (loop's _extent(object_extent(map, target))).
+    """
+    h, w = disp.shape
+    d = target.disparity
+    tol = tol_px if tol_px is not None else max(1.0, 0.06 * d)
+    x, y, bw, bh = target.bbox
+    with np.errstate(invalid="ignore"):
+        near = np.abs(disp - d) <= tol
+    cols = near[y:y + bh].mean(axis=0) >= share
+    x0, x1 = _run_through(cols, x, x + bw - 1, gap_px)
+    if x0 is None:
+        return target
+    valid_cols = np.flatnonzero(np.isfinite(disp[y:y + bh]).any(axis=0))
+    if valid_cols.size and x0 <= valid_cols[0] + 1:
+        x0 = 0
+    if valid_cols.size and x1 >= valid_cols[-1] - 1:
+        x1 = w - 1
+    rows = near[:, x0:x1 + 1].mean(axis=1) >= share
+    y0, y1 = _run_through(rows, y, y + bh - 1, gap_px)
+    if y0 is None:
+        y0, y1 = y, y + bh - 1
+    area = int(near[y0:y1 + 1, x0:x1 + 1].sum())
+    return Target(d, area, (int(x0), int(y0), int(x1 - x0 + 1), int(y1 - y0 + 1)),
+                  target.spread)
+
+
+def _run_through(flags: np.ndarray, lo: int, hi: int, gap: int) -> tuple[int, int] | tuple[
+        None, None]:
+    """The run of True in flags (gaps up to gap bridged) that meets lo..hi: its first and last
+    index; (None, None) when no flag in lo..hi is set."""
+    inside = np.flatnonzero(flags[lo:hi + 1])
+    if inside.size == 0:
+        return None, None
+    a, b = lo + int(inside[0]), lo + int(inside[-1])
+    on = np.flatnonzero(flags)
+    while True:  # extend left
+        left = on[(on < a) & (on >= a - gap - 1)]
+        if left.size == 0:
+            break
+        a = int(left[0])
+    while True:  # extend right
+        right = on[(on > b) & (on <= b + gap + 1)]
+        if right.size == 0:
+            break
+        b = int(right[-1])
+    return a, b
+
+
+def stopping_distance_m(speed_mps: float, reaction_s: float = 0.25, tau_s: float = 0.08,
+                        margin_m: float = 0.10) -> float:
+    """How far ahead of its front the robot must see an object to stop short of it (m): the
+    distance run before the STOP acts (reaction_s: a frame, the matching, the link and the
+    actuation latency), the motors' run-down (a first-order lag of tau_s coasts speed * tau_s)
+    and a margin."""
+    v = abs(speed_mps)
+    return margin_m + v * (reaction_s + tau_s)
+
+
+@dataclass(frozen=True)
+class LaneWindow:
+    """The part of the picture where an object in the robot's lane within reach would be seen:
+    the left-image box (x0, y0, x1, y1, end exclusive) and the search range to match it with
+    (min_disparity, num_disparities, a multiple of 16): from 0 to beyond both the stretch's
+    nearer end and the robot itself, so that what lies nearer or farther than the stretch
+    (the robot in front of it, the wall behind) is matched where it is rather than into wrong
+    matches inside a cut range."""
+
+    box: tuple[int, int, int, int]
+    min_disparity: int
+    num_disparities: int
+    d_near: float  # px, the disparity at the nearer end of the watched stretch
+    d_far: float  # px, at the farther end
+
+
+def lane_window(geometry: Geometry, size: tuple[int, int], depth_m: float, lateral_m: float,
+                direction: int, reach_m: float, half_width_m: float = 0.12,
+                body_m: float = 0.10, height_m: float = 0.30, camera_height_m: float = 0.25
+                ) -> LaneWindow | None:
+    """Where to watch the lane: the stretch from body_m to body_m + reach_m ahead of the robot's
+    centre (direction +1: moving away from the camera, -1: toward it), half_width_m each side
+    of its line (x = lateral_m), from the floor to height_m. depth_m, lateral_m: the robot's
+    (m, from its marker); size: (width, height) of the picture. None when the stretch leaves
+    the camera's near range (nearer than 0.25 m) or the picture. Match this box with the
+    window's range (match_window), then lane_obstacle on the map."""
+    w, h = size
+    z_a = depth_m + direction * body_m
+    z_b = depth_m + direction * (body_m + reach_m)
+    near_z, far_z = min(z_a, z_b), max(z_a, z_b)
+    if near_z < 0.25:
+        return None
+    f, b, cx, cy = geometry.focal_px, geometry.baseline_m, geometry.cx, geometry.cy
+    us = [cx + f * (lateral_m + s * half_width_m) / z for s in (-1, 1) for z in (near_z, far_z)]
+    vs = [cy + f * (camera_height_m - y) / z for y in (0.0, height_m) for z in (near_z, far_z)]
+    x0, x1 = max(0, int(math.floor(min(us)))), min(w, int(math.ceil(max(us))) + 1)
+    y0, y1 = max(0, int(math.floor(min(vs)))), min(h, int(math.ceil(max(vs))) + 1)
+    if x0 >= x1 or y0 >= y1:
+        return None
+    d_near, d_far = f * b / near_z, f * b / far_z
+    top = max(d_near, f * b / depth_m) + 4
+    return LaneWindow((x0, y0, x1, y1), 0, 16 * max(1, math.ceil(top / 16)), d_near, d_far)
+
+
+def match_window(left: np.ndarray, right: np.ndarray, params: MatcherParams,
+                 window: LaneWindow) -> np.ndarray:
+    """The disparity map (px, NaN invalid and outside the window) of the window's box, matched
+    with its disparity range and a left-right check (1 px: occluded pixels beside the robot
+    are invalid, not wrong matches): only its rows, its columns and, to their left, the search
+    range in the right view (the loop's marker-window match does the same)."""
+    h, w = left.shape[:2]
+    x0, y0, x1, y1 = window.box
+    pad = params.block_size // 2 + params.median // 2
+    a, b = max(0, y0 - pad), min(h, y1 + pad)
+    reach = window.min_disparity + window.num_disparities
+    c0, c1 = max(0, x0 - reach - pad), min(w, x1 + pad)
+    p = params.replace(min_disparity=window.min_disparity,
+                       num_disparities=window.num_disparities, lr_check=1.0)
+    with numba_threads(1):
+        band = compute_disparity(left[a:b, c0:c1], right[a:b, c0:c1], p)
+    out = np.full((h, w), np.nan, np.float32)
+    out[y0:y1, x0:x1] = band[y0 - a:y1 - a, x0 - c0:x1 - c0]
+    return out
+
+
+@dataclass(frozen=True)
+class LaneObstacle:
+    depth_m: float  # the object's depth (median over its pixels)
+    ahead_m: float  # from the robot's centre, along its motion
+    pixels: int
+
+
+def lane_obstacle(disp: np.ndarray, geometry: Geometry, depth_m: float, lateral_m: float,
+                  direction: int, reach_m: float, reference: np.ndarray | None = None,
+                  half_width_m: float = 0.12, body_m: float = 0.10, floor_clear_m: float = 0.03,
+                  height_m: float = 0.30, camera_height_m: float = 0.25, tol_px: float = 1.0,
+                  min_pixels: int = 40, robot_px: int = 4) -> LaneObstacle | None:
+    """An object in the robot's lane within reach_m ahead of its front, or None.
+
+    Each valid pixel of disp is a point in the world (x = B (u - cx) / d, z = f B / d, height
+    above the floor = camera_height_m - B (v - cy) / d). Counted: points in the stretch from
+    body_m to body_m + reach_m ahead of the robot's centre (depth_m, direction +1 away from the
+    camera, -1 toward it), within half_width_m of its line (lateral_m), higher than
+    floor_clear_m above the floor (the floor is never an obstacle, whatever the floor fit
+    says) and below height_m, not within robot_px of a pixel at the robot's own disparity
+    (the mismatches along its silhouette), and, with a reference map (the scene without the
+    robot, same geometry), nearer than what the reference had there by tol_px (the object the
+    robot drives to and the wall are not new). The largest connected patch of such pixels, if
+    it has at least min_pixels: the obstacle, at its median depth. Moving away from the camera
+    the robot hides what is right behind it: a low object is seen only beside or above it.
+
+    A result (not None) means: stop now, before it closes; reach_m is the stopping distance at
+    the current speed (stopping_distance_m) plus any margin.
+    """
+    g = geometry
+    fb = g.focal_px * g.baseline_m
+    with np.errstate(invalid="ignore"):
+        ok = np.isfinite(disp) & (disp > 0.5)
+        robot = (np.abs(disp - fb / depth_m) < 1.5).astype(np.uint8)
+    if robot_px and robot.any():
+        k = 2 * robot_px + 1
+        ok &= cv2.dilate(robot, np.ones((k, k), np.uint8)) == 0
+    vs, us = np.nonzero(ok)
+    if vs.size == 0:
+        return None
+    d = disp[vs, us].astype(np.float64)
+    z = fb / d
+    x = g.baseline_m * (us - g.cx) / d
+    y = camera_height_m - g.baseline_m * (vs - g.cy) / d
+    ahead = (z - depth_m) * direction
+    keep = ((ahead >= body_m) & (ahead <= body_m + reach_m) & (np.abs(x - lateral_m)
+            <= half_width_m) & (y > floor_clear_m) & (y < height_m))
+    if reference is not None:
+        ref = reference[vs, us]
+        with np.errstate(invalid="ignore"):
+            keep &= ~(ref >= d - tol_px)  # NaN in the reference: unknown, so new
+    if int(keep.sum()) < min_pixels:
+        return None
+    mask = np.zeros(disp.shape, np.uint8)
+    mask[vs[keep], us[keep]] = 1
+    _, labels, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
+    best = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
+    if stats[best, cv2.CC_STAT_AREA] < min_pixels:
+        return None
+    zm = float(np.median(fb / disp[labels == best]))
+    return LaneObstacle(zm, (zm - depth_m) * direction, int(stats[best, cv2.CC_STAT_AREA]))

@@ -2,25 +2,58 @@
 then as the sensors and lenses spoil them (exposure, white balance, blur, noise, distortion).
 
 The static scene (wall, floor, boxes) is painted once per layout as textured layers far to
-near; the robot goes on top each view with an anti-aliased marker at its exact sub-pixel
-position. Lens distortion maps each raw pixel to where the ideal (rectified) camera saw it, so
-a calibration on rendered chessboards recovers it as it would a real lens.
+near; the robot (and any person or second robot) goes on top each view, far to near, where it
+is nearer than what the scene has there (a robot behind a box is hidden by it), with an
+anti-aliased marker at its exact sub-pixel position. A rig knocked since its calibration
+(pitch_deg) sees the ideal view through the rotation's homography; mains flicker (flicker)
+modulates each row by the light at the time a rolling shutter reads it. Lens distortion maps
+each raw pixel to where the ideal (rectified) camera saw it, so a calibration on rendered
+chessboards recovers it as it would a real lens.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import cv2
 import numpy as np
 
 from host.camera.source import StereoFrame
 from host.sim.faults import CameraFaults
-from host.sim.world import World
+from host.sim.world import Person, Robot, World
 from host.stereo.synthetic import Layer, random_texture, render_view
 
 MARKER_DARK = 25.0
 MARKER_LIGHT = 235.0
+NEARER_PX = 0.25  # a drawn surface shows where the scene is not nearer than it by this much
+
+
+@dataclass(frozen=True)
+class Flicker:
+    """Light varying by +-amplitude (fraction) at hz, read row by row: a rolling shutter reads
+    row y readout_s * y / height after its first; the right sensor's capture begins gap_s after
+    the left's."""
+
+    amplitude: float
+    hz: float = 100.0
+    gap_s: float = 0.0
+    readout_s: float = 0.030
+
+    def gains(self, t_s: float, side: int, height: int) -> np.ndarray:
+        """Each row's light factor (float32, height) for a capture that began at t_s."""
+        rows = np.arange(height, dtype=np.float64)
+        t = t_s + (self.gap_s if side else 0.0) + self.readout_s * rows / height
+        return (1.0 + self.amplitude * np.sin(2 * math.pi * self.hz * t)).astype(np.float32)
+
+
+def rotation_homography(world: World, pitch_deg: float) -> np.ndarray:
+    """The homography that maps the ideal view to the view of a rig pitched by pitch_deg
+    (positive: tilted down) about its baseline: the pair stays rectified, the scene moves."""
+    g, a = world.geometry, math.radians(pitch_deg)
+    k = np.array([[g.focal_px, 0, g.cx], [0, g.focal_px, g.cy], [0, 0, 1]], np.float64)
+    rt = np.array([[1, 0, 0], [0, math.cos(a), -math.sin(a)], [0, math.sin(a), math.cos(a)]])
+    return k @ rt @ np.linalg.inv(k)
 
 
 def lens_maps(world: World, k1: float) -> tuple[np.ndarray, np.ndarray] | None:
@@ -45,6 +78,11 @@ class Renderer:
         self._static_key: tuple | None = None
         self._static: list[tuple[np.ndarray, np.ndarray]] = []
         self._body_tex = random_texture(np.random.default_rng(seed + 1), 64, 64, 1.2, 45, 110)
+        self._person_tex = random_texture(np.random.default_rng(seed + 2), 256, 256, 2.0, 50, 120)
+        self.pitch_deg = 0.0  # the rig's pitch since it was calibrated (a knock)
+        self._last_noise = [-1, -1]  # the noise field each sensor got last
+        self._row0 = 0  # rows of the canvas above the view's first (a pitched rig sees them)
+        self.flicker: Flicker | None = None
         self._lens = [lens_maps(world, k1) for k1 in camera.distortion]
         w, h = world.size
         # sensor noise: a bank of independent fields, one drawn at random per view (drawing a
@@ -55,52 +93,83 @@ class Renderer:
     # ------------------------------------------------------------------------ static scene
 
     def _static_views(self) -> list[tuple[np.ndarray, np.ndarray]]:
-        key = self.world.boxes
+        """Both views of the scene without robots, on a canvas of the view's size, or with
+        rows above and below it for a pitched rig to see."""
+        g = self.world.geometry
+        pad = (int(math.ceil(g.focal_px * math.tan(math.radians(abs(self.pitch_deg))))) + 2
+               if self.pitch_deg else 0)
+        key = (self.world.boxes, pad)
         if key != self._static_key:
-            self._static, self._static_key = self._render_static(), key
+            self._static, self._static_key = self._render_static(pad), key
         return self._static
 
-    def _render_static(self) -> list[tuple[np.ndarray, np.ndarray]]:
+    def _render_static(self, pad: int) -> list[tuple[np.ndarray, np.ndarray]]:
+        """The static views with pad extra rows above and below (0: the view itself); the
+        view's rows are the same with or without them (extra rows of texture come from a
+        stream of their own)."""
         world = self.world
         g, (w, h) = world.geometry, world.size
         rng = np.random.default_rng(self.seed)
+        extra = np.random.default_rng(self.seed + 3)
         fb = g.focal_px * g.baseline_m
         margin = int(fb / 0.5) + 8
 
         def tex(sigma: float, contrast: float, mean: float) -> np.ndarray:
-            return random_texture(rng, h, w + 2 * margin, sigma, contrast, mean)
+            t = random_texture(rng, h, w + 2 * margin, sigma, contrast, mean)
+            if not pad:
+                return t
+            above, below = (random_texture(extra, pad, w + 2 * margin, sigma, contrast, mean)
+                            for _ in range(2))
+            return np.vstack([above, t, below])
 
         layers = [Layer(fb / world.wall_z_m, tex(1.2, 40, 150), margin)]
         # floor: a point at depth z is at row cy + f h / z, so d = B (y - cy) / h (y below cy)
-        horizon = g.cy + g.focal_px * world.height_m / world.wall_z_m
-        layers.append(Layer(-g.baseline_m * g.cy / world.height_m, tex(0.9, 35, 95), margin,
-                            dy=g.baseline_m / world.height_m, box=(-1e4, horizon, 1e4, 1e4)))
+        horizon = g.cy + g.focal_px * world.height_m / world.wall_z_m + pad
+        layers.append(Layer(-g.baseline_m * (g.cy + pad) / world.height_m, tex(0.9, 35, 95),
+                            margin, dy=g.baseline_m / world.height_m,
+                            box=(-1e4, horizon, 1e4, 1e4)))
         for b in sorted(world.boxes, key=lambda b: -b.z_m):
             x0, y0 = world.project(b.x0_m, b.height_m, b.z_m)
             x1, y1 = world.project(b.x1_m, 0.0, b.z_m)
-            layers.append(Layer(fb / b.z_m, tex(1.0, 55, 140), margin, box=(x0, y0, x1, y1)))
-        return [render_view(layers, w, h, s)[:2] for s in (0.0, 1.0)]
+            layers.append(Layer(fb / b.z_m, tex(1.0, 55, 140), margin,
+                                box=(x0, y0 + pad, x1, y1 + pad)))
+        return [render_view(layers, w, h + 2 * pad, s)[:2] for s in (0.0, 1.0)]
+
+    def _project(self, x: float, y: float, z: float) -> tuple[float, float]:
+        """A world point's pixel on the canvas being drawn (world.project, below its extra
+        rows)."""
+        u, v = self.world.project(x, y, z)
+        return u, v + self._row0
 
     # ------------------------------------------------------------------------------- robot
 
+    def _draw_person(self, image: np.ndarray, disp: np.ndarray, shift: float,
+                     p: Person) -> None:
+        g = self.world.geometry
+        if p.z_m <= 0.2:
+            return
+        d = g.focal_px * g.baseline_m / p.z_m
+        x0, y0 = self._project(p.x_m - p.width_m / 2, p.height_m, p.z_m)
+        x1, y1 = self._project(p.x_m + p.width_m / 2, 0.0, p.z_m)
+        self._paint(image, disp, (x0 - shift * d, y0, x1 - shift * d, y1), d, self._person_tex)
+
     def _draw_robot(self, image: np.ndarray, disp: np.ndarray, shift: float,
-                    blur_px: tuple[float, float]) -> None:
-        world = self.world
-        r, g = world.robot, world.geometry
+                    blur_px: tuple[float, float], r: Robot) -> None:
+        g = self.world.geometry
         if r.z_m <= 0.2:
             return
         d = g.focal_px * g.baseline_m / r.z_m
         half_w = abs(math.cos(r.theta)) * r.body_width_m / 2 + abs(math.sin(r.theta)) * 0.08
-        x0, y0 = world.project(r.x_m - half_w, r.body_height_m, r.z_m)
-        x1, y1 = world.project(r.x_m + half_w, 0.02, r.z_m)
+        x0, y0 = self._project(r.x_m - half_w, r.body_height_m, r.z_m)
+        x1, y1 = self._project(r.x_m + half_w, 0.02, r.z_m)
         before = image.copy() if max(abs(blur_px[0]), abs(blur_px[1])) >= 0.5 else None
-        self._paint(image, disp, (x0 - shift * d, y0, x1 - shift * d, y1), d, body=True)
-        u, v, _ = world.marker_truth()
+        self._paint(image, disp, (x0 - shift * d, y0, x1 - shift * d, y1), d, self._body_tex)
+        u, v = self._project(r.x_m, r.marker_height_m, r.z_m)
         ry = g.focal_px * r.marker_radius_m / r.z_m
         rx = ry * abs(math.cos(r.theta))  # the card turns edge-on as the robot turns
-        mx0, my0 = world.project(r.x_m - 0.006, r.marker_height_m, r.z_m + 0.01)
-        mx1, my1 = world.project(r.x_m + 0.006, r.body_height_m, r.z_m + 0.01)
-        self._paint(image, disp, (mx0 - shift * d, my0, mx1 - shift * d, my1), d, body=False)
+        mx0, my0 = self._project(r.x_m - 0.006, r.marker_height_m, r.z_m + 0.01)
+        mx1, my1 = self._project(r.x_m + 0.006, r.body_height_m, r.z_m + 0.01)
+        self._paint(image, disp, (mx0 - shift * d, my0, mx1 - shift * d, my1), d, None)
         if not r.marker_hidden:
             self._marker(image, disp, u - shift * d, v, rx, ry, d, r.ring_ratio)
         if r.occlusion > 0:  # a post just in front of the card hides its left part
@@ -109,7 +178,7 @@ class Renderer:
             left = u - ring
             box = (left - shift * dp, v - 3 * ry, left + 2 * ring * r.occlusion - shift * dp,
                    v + 3 * ry)
-            self._paint(image, disp, box, dp, body=True)
+            self._paint(image, disp, box, dp, self._body_tex)
         if before is not None:
             self._blur(image, before, (min(x0, u - 2 * ry) - shift * d, min(y0, v - 2 * ry),
                                        max(x1, u + 2 * ry) - shift * d, y1), blur_px)
@@ -133,20 +202,24 @@ class Renderer:
         region = image[r0:r1, c0:c1]
         region[:] = cv2.filter2D(region, -1, k, borderType=cv2.BORDER_REPLICATE)
 
-    def _paint(self, image, disp, box, d, body: bool) -> None:
+    @staticmethod
+    def _paint(image, disp, box, d, texture: np.ndarray | None) -> None:
+        """A surface at disparity d over box (texture, or a uniform grey 60), where the scene
+        is not nearer."""
         h, w = image.shape
         x0, y0, x1, y1 = box
         c0, c1 = max(0, int(math.ceil(x0))), min(w, int(math.ceil(x1)))
         r0, r1 = max(0, int(math.ceil(y0))), min(h, int(math.ceil(y1)))
         if c0 >= c1 or r0 >= r1:
             return
-        if body:
-            t = self._body_tex
+        shown = ~(disp[r0:r1, c0:c1] > d + NEARER_PX)
+        if texture is not None:
             ys, xs = np.mgrid[r0:r1, c0:c1]
-            image[r0:r1, c0:c1] = t[(ys - r0) % t.shape[0], (xs - c0) % t.shape[1]]
+            surface = texture[(ys - r0) % texture.shape[0], (xs - c0) % texture.shape[1]]
+            image[r0:r1, c0:c1][shown] = surface[shown]
         else:
-            image[r0:r1, c0:c1] = 60.0
-        disp[r0:r1, c0:c1] = d
+            image[r0:r1, c0:c1][shown] = 60.0
+        disp[r0:r1, c0:c1][shown] = d
 
     @staticmethod
     def _marker(image, disp, u, v, rx, ry, d, ring) -> None:
@@ -165,23 +238,54 @@ class Renderer:
         ring_cov = (q <= ring * ring).mean(axis=(2, 3))
         disc_cov = (q <= 1.0).mean(axis=(2, 3))
         patch = image[r0:r1, c0:c1]
+        shown = ~(disp[r0:r1, c0:c1] > d + NEARER_PX)
         light = ring_cov - disc_cov
-        patch[:] = patch * (1 - ring_cov) + MARKER_LIGHT * light + MARKER_DARK * disc_cov
-        disp[r0:r1, c0:c1][ring_cov > 0.5] = d
+        drawn = patch * (1 - ring_cov) + MARKER_LIGHT * light + MARKER_DARK * disc_cov
+        patch[shown] = drawn[shown]
+        disp[r0:r1, c0:c1][(ring_cov > 0.5) & shown] = d
 
     # ------------------------------------------------------------------------------ views
 
     def view(self, side: int, with_robot: bool = True,
-             blur_px: tuple[float, float] = (0.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
+             blur_px: tuple[float, float] = (0.0, 0.0), t_s: float | None = None
+             ) -> tuple[np.ndarray, np.ndarray]:
         """One sensor's image now (side 0 left, 1 right) as it leaves the camera (uint8, grey
-        or BGR), and the exact disparity of the ideal left view (side 0; NaN where none)."""
-        img, disp = (a.copy() for a in self._static_views()[side])
+        or BGR), and the exact disparity of the ideal left view (side 0; NaN where none).
+        t_s: when the capture began (the flicker's phase; default the world's time). People
+        and other robots are part of the scene: drawn with or without the robot."""
+        static = self._static_views()[side]
+        img, disp = (a.copy() for a in static)
+        world = self.world
+        self._row0 = (img.shape[0] - world.size[1]) // 2
+        things: list[tuple[float, object]] = [(p.z_m, p) for p in world.people]
+        things += [(r.z_m, r) for r in world.decoys]
         if with_robot:
-            self._draw_robot(img, disp, float(side), blur_px)
+            things.append((world.robot.z_m, world.robot))
+        for _, thing in sorted(things, key=lambda zt: -zt[0]):  # far to near
+            if isinstance(thing, Person):
+                self._draw_person(img, disp, float(side), thing)
+            else:
+                blur = blur_px if thing is world.robot else (0.0, 0.0)
+                self._draw_robot(img, disp, float(side), blur, thing)
+        if self.pitch_deg:  # the canvas's rows seen through the pitched rig
+            hom = rotation_homography(world, self.pitch_deg) @ np.array(
+                [[1, 0, 0], [0, 1, -self._row0], [0, 0, 1]], np.float64)
+            img = cv2.warpPerspective(img, hom, world.size, flags=cv2.INTER_LINEAR,
+                                      borderMode=cv2.BORDER_REPLICATE)
+            disp = cv2.warpPerspective(disp, hom, world.size, flags=cv2.INTER_NEAREST,
+                                       borderMode=cv2.BORDER_CONSTANT, borderValue=math.nan)
+        if self.flicker is not None:
+            t = world.t if t_s is None else t_s
+            img = img * self.flicker.gains(t, side, img.shape[0])[:, None]
         cam = self.camera
         img = img * cam.gain[side] + cam.bias[side]
-        if self._noise is not None:
-            img += self._noise[int(self.rng.integers(len(self._noise)))]
+        if self._noise is not None:  # never the last field again: a live sensor never
+            # repeats its image exactly (a repeat is what a frozen one does)
+            k = int(self.rng.integers(len(self._noise)))
+            if k == self._last_noise[side]:
+                k = (k + 1) % len(self._noise)
+            self._last_noise[side] = k
+            img += self._noise[k]
         if cam.white:
             img = img[..., None] * np.asarray(cam.white[side], np.float32)
         lens = self._lens[side]

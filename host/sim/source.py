@@ -3,6 +3,7 @@ both in one deterministic simulated clock (lockstep: processing takes no simulat
 
 from __future__ import annotations
 
+import math
 from collections import deque
 from typing import Protocol
 
@@ -10,8 +11,8 @@ import numpy as np
 
 from host.camera.source import StereoFrame, StereoSource
 from host.sim.faults import Event
-from host.sim.renderer import Renderer
-from host.sim.world import Box, World
+from host.sim.renderer import Flicker, Renderer
+from host.sim.world import Box, Person, Robot, World
 
 
 class Board(Protocol):
@@ -26,7 +27,8 @@ class SimSource(StereoSource):
     """Frames at fps; between frames the world and the board advance in 1 ms steps, the robot
     driven by the duties the firmware applies, latency_ms later. The first reference_frames
     frames show the scene without the robot (the reference phase). The right view is captured
-    skew_ms after the left; a dropped frame never arrives (the next one comes a period later)."""
+    skew_ms after the left; a dropped frame never arrives (the next one comes a period later).
+    The scene's events (host.sim.faults.Event) happen at their times; what each did is in log."""
 
     def __init__(self, world: World, board: Board, fps: float = 30.0,
                  reference_frames: int = 5, renderer: Renderer | None = None,
@@ -43,6 +45,11 @@ class SimSource(StereoSource):
         self._pending: deque[tuple[int, tuple[int, int]]] = deque()
         self._applied = (0, 0)
         self._occluded_until = -1.0
+        self._until: dict[str, float] = {}  # when each lasting event ends
+        self._lane_box: Box | None = None
+        self._walker: Event | None = None
+        self._freeze: Event | None = None
+        self._held: list[tuple[np.ndarray, float] | None] = [None, None]  # last image, stamp
         self.log: list[str] = []  # what happened in the scene, with times
 
     @property
@@ -67,9 +74,14 @@ class SimSource(StereoSource):
         w, r = self.world, self.world.robot
         if r.occlusion and self.t >= self._occluded_until:
             r.occlusion = 0.0
+        self._end_lasting()
+        if self._walker is not None:
+            e = self._walker
+            w.people = (Person(e.x_m + e.speed_mps * (self.t - e.t_s), e.z_m),)
         while self.events and self.events[0].t_s <= self.t:
             e = self.events.pop(0)
             boxes = list(w.boxes)
+            note = ""
             if e.kind == "move" and e.index < len(boxes):
                 b = boxes[e.index]
                 boxes[e.index] = Box(e.z_m, b.x0_m, b.x1_m, b.height_m)
@@ -79,8 +91,84 @@ class SimSource(StereoSource):
                 boxes.pop(e.index)
             elif e.kind == "occlude":
                 r.occlusion, self._occluded_until = e.fraction, e.t_s + e.duration_s
+            elif e.kind == "facing":
+                r.theta = math.radians(e.angle_deg)
+            elif e.kind == "lane-box":
+                box = self._lane_box_for(e)
+                if box is None:
+                    note = " (skipped: no room ahead)"
+                else:
+                    boxes.append(box)
+                    note = f" at {box.z_m:.2f} m"
+                    if e.duration_s:
+                        self._lane_box = box
+                        self._until["lane-box"] = self.t + e.duration_s
+            elif e.kind == "knock":
+                self.renderer.pitch_deg += e.angle_deg
+            elif e.kind == "freeze":
+                self._freeze, self._until["freeze"] = e, self.t + e.duration_s
+            elif e.kind == "flicker":
+                self.renderer.flicker = Flicker(e.fraction, e.hz, e.gap_ms / 1000)
+                if e.duration_s:
+                    self._until["flicker"] = self.t + e.duration_s
+            elif e.kind == "behind" and e.index < len(boxes):
+                note = self._place_behind(boxes[e.index], e)
+            elif e.kind == "walker":
+                self._walker, self._until["walker"] = e, self.t + e.duration_s
+                w.people = (Person(e.x_m, e.z_m),)
+            elif e.kind == "slip":
+                w.traction, self._until["slip"] = e.traction, self.t + e.duration_s
+            elif e.kind == "drop-burst":
+                self._until["drop-burst"] = self.t + e.duration_s
+            elif e.kind == "decoy":
+                w.decoys = (*w.decoys, Robot(x_m=e.x_m, z_m=e.z_m))
             w.boxes = tuple(boxes)
-            self.log.append(f"{self.t:.3f} s {e.kind}")
+            self.log.append(f"{self.t:.3f} s {e.describe()}{note}")
+
+    def _end_lasting(self) -> None:
+        """End the lasting events whose time is up."""
+        w = self.world
+        for kind, until in list(self._until.items()):
+            if self.t < until:
+                continue
+            del self._until[kind]
+            if kind == "lane-box" and self._lane_box in w.boxes:
+                boxes = list(w.boxes)
+                boxes.remove(self._lane_box)
+                w.boxes, self._lane_box = tuple(boxes), None
+            elif kind == "freeze":
+                self._freeze = None
+            elif kind == "flicker":
+                self.renderer.flicker = None
+            elif kind == "walker":
+                self._walker, w.people = None, ()
+            elif kind == "slip":
+                w.traction = (1.0, 1.0)
+            self.log.append(f"{self.t:.3f} s {kind} ends")
+
+    def _lane_box_for(self, e: Event) -> Box | None:
+        """The box ahead_m ahead of the robot's centre, the way it moves (or faces), centred
+        on its line; None when that is nearer the camera than 0.35 m or beyond the wall."""
+        r, w = self.world.robot, self.world
+        vz = (r.v_left + r.v_right) / 2 * math.cos(r.theta)
+        way = math.copysign(1.0, vz if abs(vz) > 0.02 else math.cos(r.theta))
+        z = r.z_m + way * e.ahead_m
+        if not 0.35 <= z <= w.wall_z_m - 0.1:
+            return None
+        return Box(z, r.x_m - e.width_m / 2, r.x_m + e.width_m / 2, 0.3)
+
+    def _place_behind(self, box: Box, e: Event) -> str:
+        """Put the robot behind box so that its edge nearer the view's centre hides `fraction`
+        of the card's ring (the left part for a box on the left)."""
+        r, g = self.world.robot, self.world.geometry
+        r.z_m = max(r.z_m, e.z_m)
+        ring = r.marker_radius_m * r.ring_ratio  # m, at the card
+        left_box = abs(box.x1_m) < abs(box.x0_m)
+        edge = box.x1_m if left_box else box.x0_m
+        at = edge * r.z_m / box.z_m  # the edge's line of sight at the robot's depth
+        r.x_m = at + ring * (1 - 2 * e.fraction) * (1 if left_box else -1)
+        u = g.cx + g.focal_px * r.x_m / r.z_m
+        return f" at {r.z_m:.2f} m, x {r.x_m:+.3f} m (column {u:.1f})"
 
     def _read(self) -> StereoFrame | None:
         period = int(round(1000 / self.fps))
@@ -88,17 +176,28 @@ class SimSource(StereoSource):
         skew = int(round(cam.skew_ms))
         if self.index:
             self.run_ms(period - skew)
-            while cam.drop and self.rng.random() < cam.drop:
+            while ((cam.drop and self.rng.random() < cam.drop)
+                   or "drop-burst" in self._until):
                 self.dropped += 1
                 self.run_ms(period)
         with_robot = self.index >= self.reference_frames
-        vel = self.renderer.image_velocity()
-        blur = (vel[0] * cam.exposure_ms / 1000, vel[1] * cam.exposure_ms / 1000)
-        left, _ = self.renderer.view(0, with_robot, blur)
         t_left = self.t
+        left = self._capture(0, with_robot, t_left, t_left)
         self.run_ms(skew)
-        vel = self.renderer.image_velocity()
-        blur = (vel[0] * cam.exposure_ms / 1000, vel[1] * cam.exposure_ms / 1000)
-        right, _ = self.renderer.view(1, with_robot, blur)
+        right = self._capture(1, with_robot, self.t, t_left)
         self.index += 1
-        return StereoFrame(left, right, t_left, self.t)
+        return StereoFrame(left[0], right[0], left[1], right[1])
+
+    def _capture(self, side: int, with_robot: bool, stamp: float, began: float
+                 ) -> tuple[np.ndarray, float]:
+        """One sensor's image and its timestamp; a frozen sensor repeats its last image (and,
+        with stamps frozen too, its last stamp)."""
+        e, held = self._freeze, self._held[side]
+        if e is not None and e.sensor == side and held is not None:
+            return held[0], stamp if e.stamps else held[1]
+        vel = self.renderer.image_velocity()
+        blur = (vel[0] * self.renderer.camera.exposure_ms / 1000,
+                vel[1] * self.renderer.camera.exposure_ms / 1000)
+        image, _ = self.renderer.view(side, with_robot, blur, t_s=began)
+        self._held[side] = (image, stamp)
+        return image, stamp

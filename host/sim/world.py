@@ -64,6 +64,16 @@ class Robot:
     occlusion: float = 0.0  # fraction of the card's width hidden from its left edge
 
 
+@dataclass(frozen=True)
+class Person:
+    """Someone standing or walking in the scene: a textured upright slab facing the camera."""
+
+    x_m: float
+    z_m: float
+    width_m: float = 0.45
+    height_m: float = 1.75
+
+
 @dataclass
 class World:
     geometry: Geometry = field(default_factory=lambda: Geometry(426.0, 0.060, 160.0, 120.0))
@@ -77,6 +87,9 @@ class World:
     motor_faults: MotorFaults = field(default_factory=MotorFaults)
     seed: int = 0
     target_index: int | None = None  # the box the servo should end at (None: the nearest)
+    people: tuple[Person, ...] = ()
+    decoys: tuple[Robot, ...] = ()  # other robot-like bodies with the same marker, standing
+    traction: tuple[float, float] = (1.0, 1.0)  # each wheel's speed kept on this floor
 
     def __post_init__(self) -> None:
         self.rng = np.random.default_rng(self.seed + 7919)
@@ -96,23 +109,25 @@ class World:
         g = self.geometry
         return g.cx + g.focal_px * x / z, g.cy + g.focal_px * (self.height_m - y) / z
 
-    def marker_truth(self) -> tuple[float, float, float]:
-        """(left column, row, disparity) of the marker centre, exactly."""
-        r = self.robot
+    def marker_truth(self, robot: Robot | None = None) -> tuple[float, float, float]:
+        """(left column, row, disparity) of the marker centre (of `robot`, default the
+        servo's), exactly."""
+        r = robot or self.robot
         u, v = self.project(r.x_m, r.marker_height_m, r.z_m)
         return u, v, self.geometry.focal_px * self.geometry.baseline_m / r.z_m
 
     def step(self, dt: float, duty_left: float, duty_right: float) -> None:
         """Move the robot for dt seconds under the duties its wheels get (permille), through
-        the motor faults: gain and offset per wheel, battery sag with distance, wheel slip."""
+        the motor faults: gain and offset per wheel, battery sag with distance, wheel slip,
+        and the floor's traction."""
         r, m, f = self.robot, self.motors, self.motor_faults
         self.t += dt
         a = 1.0 - math.exp(-dt / m.tau_s)
         supply = max(0.5, 1.0 - f.sag_per_m * self.travelled_m)
         targets = []
-        for duty, gain, offset in ((duty_left, f.gain[0], f.offset[0]),
-                                   (duty_right, f.gain[1], f.offset[1])):
-            v = m.speed(duty * supply - math.copysign(offset, duty) if duty else 0.0) * gain
+        for duty, gain, offset, grip in ((duty_left, f.gain[0], f.offset[0], self.traction[0]),
+                                         (duty_right, f.gain[1], f.offset[1], self.traction[1])):
+            v = m.speed(duty * supply - math.copysign(offset, duty) if duty else 0.0) * gain * grip
             if f.slip and v:
                 v *= 1.0 - f.slip * float(self.rng.random())
             targets.append(v)

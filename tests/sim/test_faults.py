@@ -7,7 +7,14 @@ import math
 
 import numpy as np
 
-from host.sim.faults import CameraFaults, Event, MotorFaults, WorldFaults, random_faults
+from host.sim.faults import (
+    HAZARDS,
+    CameraFaults,
+    Event,
+    MotorFaults,
+    WorldFaults,
+    random_faults,
+)
 from host.sim.renderer import Renderer
 from host.sim.source import SimSource
 from host.sim.world import World
@@ -105,3 +112,152 @@ def test_motion_blur_smears_the_moving_marker() -> None:
 def test_world_faults_default_is_the_nominal_world() -> None:
     f = WorldFaults()
     assert f.motor == MotorFaults() and f.camera == CameraFaults() and not f.events
+
+
+# ------------------------------------------------------------------ issue 23's hazards
+
+
+def test_hazards_are_drawn_named_from_their_own_stream() -> None:
+    """Each hazard is drawn by some seed, under its own name; drawing them leaves the other
+    faults, and the caller's next draws, as they were without them."""
+    seen: set[str] = set()
+    for seed in range(200):
+        a, b = np.random.default_rng(seed), np.random.default_rng(seed)
+        with_h, without = random_faults(a, 1.2), random_faults(b, 1.2, hazards=0.0)
+        assert a.random() == b.random()
+        assert (with_h.motor, with_h.camera, with_h.link) == (without.motor, without.camera,
+                                                              without.link)
+        extra = [e for e in with_h.events if e not in without.events]
+        assert all(e.kind in HAZARDS for e in extra)
+        seen |= {e.kind for e in extra}
+    assert seen == set(HAZARDS)
+
+
+def source_with(*events: Event, robot_z: float = 0.9, camera: CameraFaults | None = None,
+                duty: tuple[int, int] = (0, 0)) -> SimSource:
+    world = World()
+    world.robot.z_m = robot_z
+    renderer = Renderer(world, camera or CameraFaults(noise=0.0))
+    return SimSource(world, Board(duty), renderer=renderer, events=events, reference_frames=0)
+
+
+def test_facing_places_the_robot_with_its_heading() -> None:
+    source = source_with(Event(0.0, "facing", angle_deg=180))
+    source.read()
+    source.read()
+    assert source.world.robot.theta == math.pi
+
+
+def test_a_lane_box_appears_ahead_of_the_moving_robot_and_is_taken_away() -> None:
+    source = source_with(Event(0.5, "lane-box", ahead_m=0.29, width_m=0.6, duration_s=0.5),
+                         duty=(500, 500))
+    source.run_ms(499)
+    assert len(source.world.boxes) == 3
+    source.run_ms(2)
+    r, box = source.world.robot, source.world.boxes[-1]
+    assert abs(box.z_m - r.z_m - 0.29) < 0.005 and abs((box.x0_m + box.x1_m) / 2 - r.x_m) < 1e-3
+    assert abs(box.x1_m - box.x0_m - 0.6) < 1e-9
+    source.run_ms(500)
+    assert len(source.world.boxes) == 3
+
+
+def test_a_knock_pitches_the_view_by_its_angle() -> None:
+    """Tilted down by 2 degrees, the scene moves up by f tan(2 deg) rows (14.9 px here), and
+    the rows it brings in are drawn, not repeated."""
+    source = source_with(Event(0.05, "knock", angle_deg=2.0))
+    before = source.read().left.astype(float)
+    for _ in range(3):
+        after = source.read().left.astype(float)
+    expect = 426.0 * math.tan(math.radians(2.0))
+    cols = slice(40, 280)
+
+    def mismatch(shift: int) -> float:
+        return float(np.abs(before[60 + shift:180 + shift, cols] - after[60:180, cols]).mean())
+
+    best = min(range(25), key=mismatch)
+    assert abs(best - expect) <= 1.0 and mismatch(best) < 0.3 * mismatch(0)
+    top = after[:10]
+    assert np.abs(np.diff(top, axis=0)).mean() > 5  # the wall goes on above, no streaks
+
+
+def test_a_frozen_sensor_repeats_its_image_with_or_without_its_stamps() -> None:
+    for stamps in (True, False):
+        source = source_with(Event(0.1, "freeze", sensor=1, stamps=stamps, duration_s=0.3),
+                             duty=(500, 500), camera=CameraFaults(noise=2.0))
+        frames = [source.read() for _ in range(16)]
+        during = [f for f in frames if 0.15 < f.t_left < 0.38]
+        assert len(during) >= 5
+        assert all(np.array_equal(f.right, during[0].right) for f in during)
+        assert not np.array_equal(during[0].left, during[1].left)
+        advancing = np.diff([f.t_right for f in during]) > 0
+        assert advancing.all() if stamps else not advancing.any()
+        assert not np.array_equal(frames[-1].right, frames[-2].right)  # it ends
+
+
+def test_flicker_bands_the_rows_differently_in_the_two_views() -> None:
+    """+-20 % at 100 Hz read by rolling shutters 10 ms apart: the row means swing by about
+    the amplitude, and the right view's bands are not the left's."""
+    plain, lit = source_with(), source_with(Event(0.0, "flicker", fraction=0.2, gap_ms=7.0))
+    plain.read(), lit.read()  # the first frame comes before any event
+    plain, lit = plain.read(), lit.read()
+    ratio_l = lit.left.mean(axis=1) / plain.left.mean(axis=1)
+    ratio_r = lit.right.mean(axis=1) / plain.right.mean(axis=1)
+    assert 0.75 < ratio_l.min() < 0.85 and 1.15 < ratio_l.max() < 1.25
+    assert np.abs(ratio_l - ratio_r).max() > 0.2
+
+
+def test_behind_the_object_half_the_card_is_hidden_by_its_edge() -> None:
+    source = source_with(Event(0.0, "behind", 0, z_m=1.6, fraction=0.5))
+    source.read()
+    f = source.read()
+    r = source.world.robot
+    assert r.z_m == 1.6
+    u, v, _ = source.world.marker_truth()
+    ry = 426.0 * r.marker_radius_m / r.z_m
+    rows = slice(int(v - ry), int(v + ry) + 1)
+    dark_left = f.left[rows, int(u - 2 * ry):int(u) - 1] < 30  # the disc is 25, no noise
+    dark_right = f.left[rows, int(u) + 1:int(u + 2 * ry)] < 30
+    assert dark_left.sum() == 0 and dark_right.sum() > 10  # the disc's left half is behind
+
+
+def test_a_walker_crosses_the_view_in_front_of_the_robot() -> None:
+    source = source_with(Event(0.05, "walker", z_m=0.6, x_m=-0.3, speed_mps=1.0,
+                               duration_s=1.0))
+    source.run_ms(300)
+    p = source.world.people[0]
+    assert abs(p.x_m - (-0.3 + 0.25)) < 0.01 and p.z_m == 0.6
+    _, disp = source.renderer.view(0)
+    col = int(160 + 426 * p.x_m / p.z_m)
+    assert abs(disp[100, col] - 426 * 0.06 / 0.6) < 0.01  # the person, in front of all
+    source.run_ms(800)
+    assert source.world.people == ()
+
+
+def test_a_smooth_floor_lets_the_wheels_slip() -> None:
+    def travelled(*events: Event) -> float:
+        source = source_with(*events, duty=(500, 500))
+        z0 = source.world.robot.z_m
+        source.run_ms(1500)
+        return source.world.robot.z_m - z0
+
+    assert travelled(Event(0.0, "slip", traction=(0.5, 0.5), duration_s=1.5)) < \
+        0.6 * travelled()
+    assert travelled(Event(0.0, "slip", traction=(0.5, 0.5), duration_s=0.5)) > \
+        0.6 * travelled()  # and grips again after it
+
+
+def test_a_burst_of_dropped_frames_leaves_a_gap_of_its_length() -> None:
+    source = source_with(Event(0.2, "drop-burst", duration_s=0.5))
+    stamps = [source.read().t_left for _ in range(12)]
+    gaps = np.diff(stamps)
+    assert 0.5 <= gaps.max() <= 0.57 and source.dropped >= 15
+
+
+def test_a_decoy_shows_a_second_marker_at_its_depth() -> None:
+    source = source_with(Event(0.0, "decoy", z_m=1.6, x_m=0.35))
+    source.read()
+    f = source.read()
+    d = source.world.decoys[0]
+    u, v, disp = source.world.marker_truth(d)
+    assert f.left[int(round(v)), int(round(u))] < 60  # its dark disc
+    assert f.right[int(round(v)), int(round(u - disp))] < 60
