@@ -33,13 +33,20 @@ from host.camera.source import CameraError, StereoFrame, StereoSource
 from host.servo.acquire import AcquireConfig, Acquisition
 from host.servo.controller import Command, ControlConfig, Controller, Observation
 from host.servo.estimator import AGAINST, OUTSIDE, STILL, Estimator, EstimatorConfig, Sighting
+from host.servo.inputs import FrozenSensors, camera_moved, views_agree
 from host.servo.marker import MarkerPair, block_disparity, marker_candidates
 from host.servo.perception import (
     Floor,
     StripMap,
     Target,
+    lane_obstacle,
+    lane_window,
     match_exposure,
+    match_window,
+    median_map,
+    object_extent,
     reference_target,
+    stopping_distance_m,
     without_floor,
 )
 from host.servo.snapshot import Observer, Snapshot, link_stats
@@ -64,6 +71,7 @@ class ServoConfig:
     remeasure_s: float = 1.0
     robot_half_width_m: float = 0.12  # the image region left out of the re-measure
     robot_below_marker_m: float = 0.22
+    lane_margin_m: float = 0.05  # watched beyond the stopping distance
     timing: TimingConfig = field(default_factory=TimingConfig)
     estimator: EstimatorConfig = field(default_factory=EstimatorConfig)
     acquire: AcquireConfig = field(default_factory=AcquireConfig)
@@ -122,6 +130,8 @@ class Servo:
         self.source, self.link, self.params = source, link, params
         self.geometry, self.control, self.clock = geometry, control, clock
         self.timing = FrameTiming(self.cfg.timing)
+        self.frozen = FrozenSensors()
+        self.reference_map: np.ndarray | None = None  # the scene without the robot, px
         self.estimator = Estimator(geometry, self.cfg.estimator)
         self.acquisition = Acquisition(self.cfg.acquire)
         self.tracker: TargetTracker | None = None
@@ -198,9 +208,11 @@ class Servo:
         self._strips = StripMap(self.params, (h, w))
         self._width = w
         target, self.floor = reference_target(disps, min_area)
+        self.reference_map = median_map(disps)
         self.tracker = TargetTracker(target, min_area, self.cfg.tracker)
         self.controller = Controller(self.geometry.depth_m(target.disparity), self.control)
-        self.controller.keep_out = self._extent(target)
+        self.controller.keep_out = self._extent(
+            object_extent(without_floor(self.reference_map, self.floor), target))
         return target
 
     def _extent(self, target: Target) -> tuple[float, float]:
@@ -304,19 +316,55 @@ class Servo:
         hide = self._robot_region(robot_at, frame.left.shape)
         whole = self._strips.add(frame.left, frame.right, hide)
         if whole is not None:
-            self._remeasure(whole)
+            self._remeasure(whole, frame)
 
-    def _remeasure(self, disp: np.ndarray) -> None:
-        """The tracker's measure on the whole map disp (the robot's region NaN)."""
+    def _remeasure(self, disp: np.ndarray, frame: StereoFrame) -> None:
+        """The tracker's measure on the whole map disp (the robot's region NaN); first, that
+        the camera has not moved since the reference (the floor fit would no longer remove
+        the floor, and its rows pass for the object): if it has, the run stops."""
         assert self.tracker is not None and self.controller is not None
-        target = self.tracker.update(without_floor(disp, self.floor))
+        moved = camera_moved(disp, self.floor, reference=self.reference_map)
+        if moved:
+            self.stop_reason = moved
+            return
+        clean = without_floor(disp, self.floor)
+        target = self.tracker.update(clean, lambda t: views_agree(
+            frame.left, frame.right, t.bbox, t.disparity))
         if self.tracker.stop_reason:
             self.stop_reason = self.tracker.stop_reason
         if self.tracker.retargeted:
             self.notes.append(f"a nearer object appeared at {target.disparity:.2f} px: "
                               f"retargeting")
-            self.controller.keep_out = self._extent(target)
+            self.controller.keep_out = self._extent(object_extent(clean, target))
         self.controller.target_m = self.geometry.depth_m(target.disparity)
+
+    # ---------------------------------------------------------------------- the lane
+
+    def _lane_blocked(self, frame: StereoFrame) -> str:
+        """An object in the lane ahead of the robot within its stopping distance at its speed
+        (and lane_margin_m), the way the control law will move it (toward the target's
+        depth), outside the robot's own image region: why the robot must stop, or "". Moving
+        away from the camera, what the robot hides is seen only beside or above it."""
+        est, c = self.estimator, self.controller
+        if est.state is None or c is None or self.reference_map is None:
+            return ""
+        z, x = est.state.z, est.state.x
+        direction = 1 if z < c.target_m else -1
+        duty = abs(self._cmd.left + self._cmd.right) / 2
+        speed = max(abs(est.state.vz), est.cfg.max_speed_mps * duty / 1000)
+        reach = stopping_distance_m(speed) + self.cfg.lane_margin_m
+        h, w = frame.left.shape[:2]
+        window = lane_window(self.geometry, (w, h), z, x, direction, reach)
+        if window is None:
+            return ""
+        disp = match_window(frame.left, frame.right, self.params, window)
+        if self.last_pair is not None:  # the robot's own body (its texture mismatches)
+            x0, y0, x1, y1 = self._robot_region(self.last_pair, frame.left.shape)
+            disp[y0:y1, x0:x1] = np.nan
+        found = lane_obstacle(disp, self.geometry, z, x, direction, reach, self.reference_map)
+        if found is None:
+            return ""
+        return f"an object in the lane {found.ahead_m:.2f} m ahead"
 
     # -------------------------------------------------------------------- acquisition
 
@@ -390,9 +438,10 @@ class Servo:
         last = self.rows[-1] if self.rows else None
         frame = self._frame()
         t_wall = time.perf_counter()
+        frozen = self.frozen.update(frame)
         frame = self._exposed(frame)
         t = frame.t_left
-        invalid = self.timing.check(self.clock(), t, frame.t_right)
+        invalid = self.timing.check(self.clock(), t, frame.t_right) or frozen
         seen = self._see(frame)
         pair = seen.pair
         position = None
@@ -410,6 +459,13 @@ class Servo:
         if self.estimator.outside_too_long(t) and not self.stop_reason:
             self.stop_reason = f"{OUTSIDE} ({self.estimator.why})"
         cmd = self._decide(t, pair, position, seen.disparity, invalid)
+        if not cmd.is_stop and cmd.phase in ("drive", "creep", "probe"):
+            blocked = self._lane_blocked(frame)
+            if blocked:  # the controller learns that it stood (its creep floor must not rise)
+                cmd = Command(0, 0, "obstacle", cmd.error_m)
+                assert self.controller is not None
+                self.controller.phase = "obstacle"
+                invalid = invalid or blocked
         t_send = time.perf_counter()
         self._send(cmd)
         rtt_ms = (time.perf_counter() - t_send) * 1000
