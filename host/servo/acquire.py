@@ -7,8 +7,8 @@ way the robot faces by what a short probe move does (a pure state machine, one c
     measure  standing, noise_frames sightings of its disparity (their spread is the noise)
     probe    both wheels at probe_duty (raised by probe_step every probe_step_s), forward or
              backward (direction: the way the robot must go if it faces away), until
-             the marker has moved probe_m (and well beyond its noise, on lines fitted through
-             the probe's sightings): its depth grew, the robot faces away from the camera,
+             the marker has moved probe_m (and three times its noise, the median of the last
+             five sightings against the first five's): the way it faces follows,
              else toward it; nothing moved by probe_s: the run stops with that reason
 """
 
@@ -104,14 +104,13 @@ class Acquisition:
         if position is None:
             return Order(0, 0, PROBE)  # not seen: stand until it is
         self._track.append((t, *position))
-        if len(self._track) >= 6:
-            # the move so far, from lines fitted through the probe's sightings: the fit's end
-            # points have about sqrt(12 / n) / 2 of one sighting's noise each
-            ts = np.array([p[0] for p in self._track])
-            span = ts[-1] - ts[0]
-            dz = float(np.polyfit(ts, [p[1] for p in self._track], 1)[0]) * span
-            dx = float(np.polyfit(ts, [p[2] for p in self._track], 1)[0]) * span
-            if math.hypot(dz, dx) >= max(cfg.probe_m, 3 * noise_m * math.sqrt(12 / len(ts))):
+        if len(self._track) >= 10:
+            # the move so far: the median of the last five sightings against the first five's
+            # (one wild sighting decides nothing), beyond three of a sighting's noise
+            first, last = self._track[:5], self._track[-5:]
+            dz = float(np.median([p[1] for p in last]) - np.median([p[1] for p in first]))
+            dx = float(np.median([p[2] for p in last]) - np.median([p[2] for p in first]))
+            if math.hypot(dz, dx) >= max(cfg.probe_m, 3 * noise_m):
                 self.facing_away = (dz > 0) == (self.direction > 0)
                 self._begin(DONE, t)
                 return Order(0, 0, PROBE)

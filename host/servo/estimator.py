@@ -14,9 +14,10 @@ sightings. A sighting outside the gate is not used; seen only outside it for out
 the run stops with that reason.
 
 Motion check: while the robot is driven straight one way, its depth must move that way. Moved
-against_m the other way, the robot faces the other way than assumed ("against"); driven at
-still_duty or more for still_s without the marker moving ("still"), what is seen is not the
-robot moving (a marker painted on the wall, a frozen picture, a stuck robot).
+against_m (and three of a sighting's noise; medians of five) the other way, the robot faces
+the other way than assumed ("against"); driven at still_duty or more for still_s without the
+marker moving ("still"), what is seen is not the robot moving (a marker painted on the wall, a
+frozen picture, a stuck robot).
 """
 
 from __future__ import annotations
@@ -224,14 +225,17 @@ class Estimator:
             return ""
         self._segment.append((t, self.state.z, self.state.x))
         seg = self._segment
-        if len(seg) < 5:
+        if len(seg) < 10:
             return ""
-        ts = np.array([p[0] for p in seg])
-        dz = float(np.polyfit(ts - ts[-1], [p[1] for p in seg], 1)[0]) * (ts[-1] - ts[0])
-        if dz * sign < -self.cfg.against_m:
+        # the median of the last five against the first five's: one wild sighting decides
+        # nothing; the move must be beyond three of a sighting's noise too
+        z0, z1 = (float(np.median([p[1] for p in part])) for part in (seg[:5], seg[-5:]))
+        dz = z1 - z0
+        noise = 3 * self.sigma_px * z1 * z1 / (self.g.focal_px * self.g.baseline_m)
+        if dz * sign < -max(self.cfg.against_m, noise):
             self._segment.clear()
             return AGAINST
-        if key[1] and ts[-1] - ts[0] >= self.cfg.still_s:
+        if key[1] and seg[-1][0] - seg[0][0] >= self.cfg.still_s:
             dx = max(p[2] for p in seg) - min(p[2] for p in seg)
             if abs(dz) < self.cfg.still_m and dx < self.cfg.still_m:
                 self._segment.clear()
