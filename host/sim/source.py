@@ -59,6 +59,11 @@ class SimSource(StereoSource):
     def clock(self) -> float:
         return self.t
 
+    @property
+    def frozen(self) -> bool:
+        """A sensor is repeating its last image now (the truth a test judges the servo by)."""
+        return self._freeze is not None
+
     def run_ms(self, ms: int) -> None:
         """Advance the world and the board by ms, one millisecond at a time."""
         for _ in range(ms):
