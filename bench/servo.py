@@ -40,7 +40,7 @@ from host.stereo.matcher import SERIAL_WORK, warm_up
 
 STAGES = {  # what the loop calls, by the name the table prints
     "exposure": (loop, "match_exposure"),
-    "marker": (loop, "find_marker"),
+    "marker": (loop, "marker_candidates"),
     "marker window match": (loop.Servo, "_robot_disparity"),
     "re-measure band": (StripMap, "add"),
     "re-measure analysis": (loop.Servo, "_remeasure"),

@@ -61,25 +61,41 @@ class FrozenSensors:
         return "; ".join(reasons)
 
 
-def floor_shift_px(disp: np.ndarray, floor: Floor, min_rows: int = 10) -> float:
+def _row_mode(row: np.ndarray) -> float:
+    """The most common disparity of a row's valid pixels (0.25 px bins)."""
+    hist, edges = np.histogram(row, bins=np.arange(row.min(), row.max() + 0.5, 0.25))
+    k = int(np.argmax(hist))
+    return float((edges[k] + edges[k + 1]) / 2)
+
+
+def floor_shift_px(disp: np.ndarray, floor: Floor, min_rows: int = 10,
+                   reference: np.ndarray | None = None) -> float:
     """How far (px of disparity) the floor in disp lies from the reference's floor line: the
     median over the lowest 40 % of rows of each row's most common disparity minus the line's
     (a pitch of the rig by a moves the floor's rows by f tan a, and so its disparity by the
-    line's slope times that). NaN when fewer than min_rows rows show enough valid pixels."""
+    line's slope times that). With the reference map (the scene without the robot), only the
+    rows that the floor dominates there, over the pixels valid in disp (with the robot's region
+    left out, an object may dominate a row the floor dominated). NaN when fewer than min_rows
+    rows show enough valid pixels."""
     h, w = disp.shape
     diffs = []
     for y in range(int(h * 0.6), h):
-        row = disp[y][np.isfinite(disp[y])]
+        valid = np.isfinite(disp[y])
+        row = disp[y][valid]
         if row.size < w // 4:
             continue
-        hist, edges = np.histogram(row, bins=np.arange(row.min(), row.max() + 0.5, 0.25))
-        if hist.size:
-            k = int(np.argmax(hist))
-            diffs.append((edges[k] + edges[k + 1]) / 2 - float(floor.disparity(np.float64(y))))
+        line = float(floor.disparity(np.float64(y)))
+        if reference is not None:
+            ref = reference[y][valid]
+            ref = ref[np.isfinite(ref)]
+            if ref.size < w // 4 or abs(_row_mode(ref) - line) > 0.5:
+                continue  # not a floor row, seen as disp sees it
+        diffs.append(_row_mode(row) - line)
     return float(np.median(diffs)) if len(diffs) >= min_rows else math.nan
 
 
-def camera_moved(disp: np.ndarray, floor: Floor | None, max_shift_px: float = 0.6) -> str:
+def camera_moved(disp: np.ndarray, floor: Floor | None, max_shift_px: float = 0.6,
+                 reference: np.ndarray | None = None) -> str:
     """"" while the reference phase's floor fit still fits the floor in disp, else the reason
     (the camera was knocked or tugged: the reference no longer removes the floor, and the
     floor's rows would pass for an object). disp: a whole map of this run (the robot's region
@@ -88,7 +104,7 @@ def camera_moved(disp: np.ndarray, floor: Floor | None, max_shift_px: float = 0.
     A yaw or a sideways shift leaves the floor's rows where they were and is not reported."""
     if floor is None:
         return ""
-    shift = floor_shift_px(disp, floor)
+    shift = floor_shift_px(disp, floor, reference=reference)
     if math.isfinite(shift) and abs(shift) > max_shift_px:
         return (f"the floor is {shift:+.1f} px off its reference fit: the camera moved "
                 f"since the reference")

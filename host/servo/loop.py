@@ -1,52 +1,81 @@
 """The servo loop: frames in, disparity, target and marker, control law, command out.
 
     reference phase: several frames of the scene without the robot -> the nearest object's
-                     disparity is the target
-    noise phase:     the robot stands while noise_frames frames measure the marker's disparity
-                     noise; a tolerance below the depth noise this gives at the target is widened
-                     to it, and the servo says so (notes)
-    robot phase:     each frame -> the marker's disparity, cross-checked by block matching over
-                     the marker with the search range set around it (min-disp / num-disp follow
-                     the marker, so near range is not cut off) -> depth (m) -> Controller ->
-                     SET_DRIVE or STOP over the link
+                     disparity is the target (TargetTracker keeps it true during the run)
+    acquisition:     find the marker (spinning in place if it is not in view), measure its
+                     disparity noise standing, and learn by a short probe move which way the
+                     robot faces (Acquisition); a tolerance below the depth noise at the target
+                     is widened to it, and the servo says so (notes)
+    robot phase:     each frame -> marker candidates -> the first the Estimator's gate admits
+                     (where the robot can be, given its commands) and block matching over it
+                     confirms -> depth (m) -> Controller -> SET_DRIVE or STOP over the link;
+                     the Estimator also checks that the depth moves the way the robot is driven
     every remeasure_s the target is measured again outside the robot's own image region (on a
-    whole map matched a band of rows per frame, StripMap): it follows the object when it moves,
-    retargets when a nearer object appears, and the run stops ("target vanished") when nothing is
-    left where it was.
+    whole map matched a band of rows per frame, StripMap).
 
-Time comes from the frames' capture timestamps: a frame whose capture follows the previous one by
-more than stale_s, or that arrives stale_s later than frames usually do, is stale; a pair whose
-two captures differ by more than max_skew_s is unusable, and a smaller skew is corrected with the
-marker's measured image speed. Any exception leaves through the link's context manager, which
-sends STOP.
+Each piece is a state machine of its own (FrameTiming, Estimator, Acquisition, TargetTracker,
+Controller); step() composes them. Time comes from the frames' capture timestamps. Any
+exception leaves through the link's context manager, which sends STOP.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from host.camera.calibration import Geometry
 from host.camera.source import CameraError, StereoFrame, StereoSource
-from host.errors import HostError
+from host.servo.acquire import AcquireConfig, Acquisition
 from host.servo.controller import Command, ControlConfig, Controller, Observation
-from host.servo.marker import MarkerPair, block_disparity, find_marker
+from host.servo.estimator import AGAINST, OUTSIDE, STILL, Estimator, EstimatorConfig, Sighting
+from host.servo.inputs import FrozenSensors, camera_moved, views_agree
+from host.servo.marker import MarkerPair, block_disparity, marker_candidates
 from host.servo.perception import (
     Floor,
     StripMap,
     Target,
+    lane_obstacle,
+    lane_window,
     match_exposure,
-    nearest_object,
+    match_window,
+    median_map,
+    object_extent,
     reference_target,
+    stopping_distance_m,
     without_floor,
 )
 from host.servo.snapshot import Observer, Snapshot, link_stats
+from host.servo.timing import FrameTiming, TimingConfig
+from host.servo.tracker import TargetTracker, TrackerConfig
 from host.stereo.matcher import compute_disparity
 from host.stereo.params import MatcherParams
+
+AGAINST_REASON = "the depth moves against the commanded direction"
+STILL_REASON = "the marker did not move while the robot drove"
+MAX_FLIPS = 2  # heading corrections in a run before "against" ends it
+
+
+@dataclass(frozen=True)
+class ServoConfig:
+    marker: str = "disc"  # or "aruco"
+    marker_radius_m: float | None = 0.03  # the disc's radius on the card; None: unknown
+    reference_frames: int = 5
+    min_area: int | None = None  # px; None: 1% of the image
+    full_map: bool = False  # cross-check the marker on the whole map (tests)
+    max_mismatch_px: float = 1.5  # block matching against the marker's centres
+    remeasure_s: float = 1.0
+    robot_half_width_m: float = 0.12  # the image region left out of the re-measure
+    robot_below_marker_m: float = 0.22
+    lane_margin_m: float = 0.05  # watched beyond the stopping distance
+    timing: TimingConfig = field(default_factory=TimingConfig)
+    estimator: EstimatorConfig = field(default_factory=EstimatorConfig)
+    acquire: AcquireConfig = field(default_factory=AcquireConfig)
+    tracker: TrackerConfig = field(default_factory=TrackerConfig)
 
 
 @dataclass
@@ -55,7 +84,7 @@ class LogRow:
     phase: str
     reason: str  # why the robot is stopped when it is ("" while it moves or holds)
     target_m: float
-    depth_m: float  # the marker's depth, NaN when not seen
+    depth_m: float  # the marker's depth, NaN when not seen (or not admitted)
     error_m: float
     target_px: float
     robot_px: float  # NaN when the marker was not seen
@@ -80,45 +109,65 @@ class Step:
     row: LogRow
 
 
+@dataclass
+class _Seen:
+    """The marker in one frame, as perception and the gate left it."""
+
+    pair: MarkerPair | None = None  # admitted and confirmed
+    disparity: float = math.nan  # px, skew-free
+    block: float = math.nan  # px, the cross-check
+    disp: np.ndarray | None = None
+    rows: tuple[int, int] = (0, 0)
+    rejected: str = ""  # why the best candidate was not used
+
+
 class Servo:
     def __init__(self, source: StereoSource, link, params: MatcherParams, geometry: Geometry,
-                 control: ControlConfig = ControlConfig(), marker: str = "disc",
-                 reference_frames: int = 5, min_area: int | None = None, stale_s: float = 0.3,
-                 clock: Callable[[], float] = time.monotonic, full_map: bool = False,
-                 max_mismatch_px: float = 1.5, marker_radius_m: float | None = 0.03,
-                 max_skew_s: float = 0.045, remeasure_s: float = 1.0, noise_frames: int = 8,
-                 robot_half_width_m: float = 0.12, robot_below_marker_m: float = 0.22) -> None:
+                 control: ControlConfig = ControlConfig(), config: ServoConfig | None = None,
+                 clock: Callable[[], float] = time.monotonic, **overrides) -> None:
+        """overrides: fields of ServoConfig (marker=, marker_radius_m=, full_map= ...)."""
+        self.cfg = dataclasses.replace(config or ServoConfig(), **overrides)
         self.source, self.link, self.params = source, link, params
-        self.geometry, self.control, self.marker = geometry, control, marker
-        self.reference_frames, self.stale_s, self.clock = reference_frames, stale_s, clock
-        self.min_area = min_area
-        self.full_map = full_map
-        self.max_mismatch_px = max_mismatch_px
-        self.marker_radius_m = marker_radius_m  # the disc's radius on the card; None: unknown
-        self.max_skew_s, self.remeasure_s, self.noise_frames = max_skew_s, remeasure_s, noise_frames
-        self.robot_half_width_m, self.robot_below_marker_m = robot_half_width_m, \
-            robot_below_marker_m
-        self.last_pair: MarkerPair | None = None
-        self.target: Target | None = None
-        self.floor: Floor | None = None
+        self.geometry, self.control, self.clock = geometry, control, clock
+        self.timing = FrameTiming(self.cfg.timing)
+        self.frozen = FrozenSensors()
+        self.reference_map: np.ndarray | None = None  # the scene without the robot, px
+        self.estimator = Estimator(geometry, self.cfg.estimator)
+        self.acquisition = Acquisition(self.cfg.acquire)
+        self.tracker: TargetTracker | None = None
         self.controller: Controller | None = None
+        self.floor: Floor | None = None
+        self.last_pair: MarkerPair | None = None  # the last admitted sighting
         self.rows: list[LogRow] = []
         self.last: Step | None = None
         self.notes: list[str] = []  # what the servo decided and the user should know
         self.stop_reason = ""  # set when the run must end: by the servo itself, or request_stop
-        self.mismatches = 0
+        self.mismatches = 0  # candidates block matching refused
         self.observers: list[Observer] = []  # called with a Snapshot after every frame
         self.requested_stop: str | None = None  # why the user stopped the run (request_stop)
-        self._noise: list[float] = []
-        self._measuring = noise_frames > 1
-        self._target_history: list[float] = []
-        self._remeasure_t: float | None = None
+        self.flips = 0  # heading corrections by the motion check
         self._strips: StripMap | None = None  # the re-measure's map, a band per frame
-        self._doubt = (0, "")  # consecutive re-measures that disagree, and how
-        self._prev: tuple[float, float, float] | None = None  # t_right, right u, skew-free d
-        self._latency_floor: float | None = None
-        self._last_capture: float | None = None
+        self._remeasure_t: float | None = None
+        self._cmd = Command(0, 0, "wait", None)  # the command in force
         self._width = 0
+
+    @property
+    def stale_s(self) -> float:
+        return self.cfg.timing.stale_s
+
+    @property
+    def target(self) -> Target | None:
+        return self.tracker.target if self.tracker else None
+
+    @property
+    def target_m(self) -> float:
+        assert self.controller is not None
+        return self.controller.target_m
+
+    @property
+    def tolerance_m(self) -> float:
+        assert self.controller is not None
+        return self.controller.cfg.tolerance_m
 
     def _frame(self) -> StereoFrame:
         frame = self.source.read()
@@ -131,8 +180,6 @@ class Servo:
         """The pair with the right view brought to the left's exposure."""
         return StereoFrame(frame.left, match_exposure(frame.left, frame.right), frame.t_left,
                            frame.t_right)
-
-    # ------------------------------------------------------------------ reference phase
 
     def request_stop(self, reason: str) -> None:
         """Stop the robot at the next frame (any thread may call this); that step's phase is
@@ -147,22 +194,26 @@ class Servo:
             for observer in self.observers:
                 observer(snap)
 
+    # ------------------------------------------------------------------ reference phase
+
     def reference(self) -> Target:
         disps = []
-        for _ in range(self.reference_frames):
+        for _ in range(self.cfg.reference_frames):
             f = self._exposed(self._frame())
             disps.append(compute_disparity(f.left, f.right, self.params))
             self._notify(f, "reference", "measuring the scene", disps[-1], 0, None, None)
             self.link.stop()  # keeps the link alive while the robot waits
         h, w = disps[0].shape
-        self.min_area = self.min_area or (w * h) // 100
+        min_area = self.cfg.min_area or (w * h) // 100
         self._strips = StripMap(self.params, (h, w))
-        self.target, self.floor = reference_target(disps, self.min_area)
-        self._target_history = [self.target.disparity] * 2
-        self.controller = Controller(self.geometry.depth_m(self.target.disparity), self.control)
         self._width = w
-        self.controller.keep_out = self._extent(self.target)
-        return self.target
+        target, self.floor = reference_target(disps, min_area)
+        self.reference_map = median_map(disps)
+        self.tracker = TargetTracker(target, min_area, self.cfg.tracker)
+        self.controller = Controller(self.geometry.depth_m(target.disparity), self.control)
+        self.controller.keep_out = self._extent(
+            object_extent(without_floor(self.reference_map, self.floor), target))
+        return target
 
     def _extent(self, target: Target) -> tuple[float, float]:
         """The object's lateral extent (m) at its depth, from its image region; a side cut by
@@ -172,11 +223,6 @@ class Servo:
         x0 = -math.inf if bx <= 0 else g.baseline_m * (bx - g.cx) / d
         x1 = math.inf if bx + bw >= self._width else g.baseline_m * (bx + bw - g.cx) / d
         return x0, x1
-
-    @property
-    def target_m(self) -> float:
-        assert self.controller is not None
-        return self.controller.target_m
 
     # --------------------------------------------------------------------- perception
 
@@ -188,7 +234,7 @@ class Servo:
                          ) -> tuple[float, np.ndarray, tuple[int, int]]:
         """Block-matching disparity over the marker (a band of rows, or the whole map)."""
         params = self._band_params(pair.disparity)
-        if self.full_map:
+        if self.cfg.full_map:
             disp = compute_disparity(frame.left, frame.right, params)
             return block_disparity(disp, pair.left), disp, (0, frame.left.shape[0])
         # only the window the ring's matches need: its rows, its columns and, to their left,
@@ -205,31 +251,41 @@ class Servo:
         full[:, x0:x1] = band
         return block_disparity(band, shifted), full, (y0, y1)
 
-    def _timing(self, frame: StereoFrame) -> str:
-        """Why the frame is unusable by its capture times ("stale", "skew"), or ""."""
-        now = self.clock()
-        latency = now - frame.t_left
-        if self._latency_floor is None or latency < self._latency_floor:
-            self._latency_floor = latency
-        gap = frame.t_left - self._last_capture if self._last_capture is not None else 0.0
-        self._last_capture = frame.t_left
-        if gap > self.stale_s or latency - self._latency_floor > self.stale_s:
-            return "stale"
-        if abs(frame.t_right - frame.t_left) > self.max_skew_s:
-            return "skew"
-        return ""
+    @staticmethod
+    def _sighting(t: float, pair: MarkerPair) -> Sighting:
+        b = pair.left
+        return Sighting(t, pair.disparity, b.u, 2 * b.radius / (1 + min(1.0, b.aspect)))
 
-    def _skew_corrected(self, frame: StereoFrame, pair: MarkerPair) -> float:
-        """The pair's disparity as if the right sensor had captured with the left: the right
-        centre moved back by its measured image speed times the skew."""
-        d = pair.disparity
-        skew = frame.t_right - frame.t_left
-        if self._prev is not None and skew and frame.t_right > self._prev[0]:
-            speed = (pair.right.u - self._prev[1]) / (frame.t_right - self._prev[0])
-            if frame.t_right - self._prev[0] < 3 * self.stale_s:
-                d += speed * skew
-        self._prev = (frame.t_right, pair.right.u, d)
-        return d
+    def _see(self, frame: StereoFrame) -> _Seen:
+        """The marker: the best candidate the estimator's gate admits and block matching over
+        it confirms. Candidates near the last sighting first; all of them refused, the whole
+        image is searched (the robot may be elsewhere, and a look-alike near)."""
+        seen = _Seen()
+        cfg, g = self.cfg, self.geometry
+        for whole in (False, True):
+            if whole and (self.last_pair is None or not seen.rejected):
+                break
+            candidates = marker_candidates(frame.left, frame.right, cfg.marker,
+                                           cfg.marker_radius_m, g.baseline_m, self.last_pair,
+                                           whole=whole)
+            checked = 0
+            for pair in candidates:
+                why = self.estimator.gate(self._sighting(frame.t_left, pair))
+                if why:
+                    seen.rejected = seen.rejected or why
+                    continue
+                if checked == 2:
+                    break  # at most two cross-checks a frame
+                checked += 1
+                block, disp, rows = self._robot_disparity(frame, pair)
+                seen.block, seen.disp, seen.rows = block, disp, rows
+                if math.isfinite(block) and abs(block - pair.disparity) > cfg.max_mismatch_px:
+                    self.mismatches += 1  # two blobs that are not the marker's two views
+                    seen.rejected = seen.rejected or "its block matching disagrees"
+                    continue
+                seen.pair, seen.rejected = pair, ""
+                return seen
+        return seen
 
     # ---------------------------------------------------------------------- the target
 
@@ -238,68 +294,84 @@ class Servo:
         ppm = pair.disparity / self.geometry.baseline_m
         h, w = shape[:2]
         u, v, r = pair.left.u, pair.left.v, pair.left.radius
-        half = self.robot_half_width_m * ppm
+        half = self.cfg.robot_half_width_m * ppm
         return (max(0, int(u - half)), max(0, int(v - 2 * r)), min(w, int(u + half) + 1),
-                min(h, int(v + self.robot_below_marker_m * ppm) + 1))
+                min(h, int(v + self.cfg.robot_below_marker_m * ppm) + 1))
 
-    def _remeasure(self, disp: np.ndarray) -> None:
-        """Measure the nearest object again on the whole map disp (the robot's region NaN);
-        follow it."""
-        assert self.target is not None and self.controller is not None
-        disp = without_floor(disp, self.floor)
-        old = self.target
-        bx, by, bw, bh = old.bbox
-        there = disp[by:by + bh, bx:bx + bw]
-        there = there[np.isfinite(there)]
-        if there.size < self.min_area // 4:
-            return  # the robot hides the object: nothing to learn
-        try:
-            found: Target | None = nearest_object(disp, self.min_area, near=old.disparity)
-        except HostError:
-            found = None
-        overlap = found is not None and min(bx + bw, found.bbox[0] + found.bbox[2]) - max(
-            bx, found.bbox[0]) > 0.3 * min(bw, found.bbox[2])
-        if found is not None and overlap:
-            self._doubt = (0, "")
-            self._target_history.append(found.disparity)
-            median = float(np.median(self._target_history[-3:]))
-            self.target = Target(median, found.area, found.bbox, found.spread)
-        else:
-            # gone means seen through: most of the object's area now shows what lies behind
-            # it; a region hidden by something nearer (or masked as the robot) is not gone
-            behind = int(np.count_nonzero(there < old.disparity - max(1.0, 0.1 * old.disparity)))
-            if behind >= old.area // 2:
-                kind = "vanished"
-            elif found is not None and found.disparity > old.disparity:
-                kind = "appeared"
-            else:
-                return  # hidden, or nothing clear: nothing to learn
-            n = self._doubt[0] + 1 if self._doubt[1] == kind else 1
-            self._doubt = (n, kind)
-            if n < 2:
-                return
-            if kind == "vanished":
-                self.stop_reason = "target vanished"
-                return
-            assert found is not None
-            self.notes.append(f"a nearer object appeared at {found.disparity:.2f} px: "
+    def _remeasure_band(self, frame: StereoFrame, pair: MarkerPair | None) -> None:
+        """Every remeasure_s, a band of the re-measure's map each frame, then the map to the
+        tracker. The robot is left out of the scene: with its marker unseen this frame, where
+        it was last seen (it stops when the marker is lost); never seen, or spinning: skip."""
+        assert self._strips is not None and self.controller is not None
+        due = self._remeasure_t is None or frame.t_left - self._remeasure_t >= \
+            self.cfg.remeasure_s
+        if due:
+            self._remeasure_t = frame.t_left
+        if not (due or self._strips.busy):
+            return
+        robot_at = pair or self.last_pair
+        if self._cmd.phase in ("turn", "search", "find") or robot_at is None:
+            self._strips.reset()
+            return
+        hide = self._robot_region(robot_at, frame.left.shape)
+        whole = self._strips.add(frame.left, frame.right, hide)
+        if whole is not None:
+            self._remeasure(whole, frame)
+
+    def _remeasure(self, disp: np.ndarray, frame: StereoFrame) -> None:
+        """The tracker's measure on the whole map disp (the robot's region NaN); first, that
+        the camera has not moved since the reference (the floor fit would no longer remove
+        the floor, and its rows pass for the object): if it has, the run stops."""
+        assert self.tracker is not None and self.controller is not None
+        moved = camera_moved(disp, self.floor, reference=self.reference_map)
+        if moved:
+            self.stop_reason = moved
+            return
+        clean = without_floor(disp, self.floor)
+        target = self.tracker.update(clean, lambda t: views_agree(
+            frame.left, frame.right, t.bbox, t.disparity))
+        if self.tracker.stop_reason:
+            self.stop_reason = self.tracker.stop_reason
+        if self.tracker.retargeted:
+            self.notes.append(f"a nearer object appeared at {target.disparity:.2f} px: "
                               f"retargeting")
-            self.target = found
-            self._target_history = [found.disparity] * 2
-            self.controller.keep_out = self._extent(found)
-        self.controller.target_m = self.geometry.depth_m(self.target.disparity)
+            self.controller.keep_out = self._extent(object_extent(clean, target))
+        self.controller.target_m = self.geometry.depth_m(target.disparity)
 
-    # ---------------------------------------------------------------------- noise phase
+    # ---------------------------------------------------------------------- the lane
 
-    def _noise_phase(self, disparity: float) -> bool:
-        """Collect the standing robot's disparities; at the end widen a tolerance below the
-        depth noise at the target. True while the phase goes on."""
-        self._noise.append(disparity)
-        if len(self._noise) < self.noise_frames:
-            return True
+    def _lane_blocked(self, frame: StereoFrame) -> str:
+        """An object in the lane ahead of the robot within its stopping distance at its speed
+        (and lane_margin_m), the way the control law will move it (toward the target's
+        depth), outside the robot's own image region: why the robot must stop, or "". Moving
+        away from the camera, what the robot hides is seen only beside or above it."""
+        est, c = self.estimator, self.controller
+        if est.state is None or c is None or self.reference_map is None:
+            return ""
+        z, x = est.state.z, est.state.x
+        direction = 1 if z < c.target_m else -1
+        duty = abs(self._cmd.left + self._cmd.right) / 2
+        speed = max(abs(est.state.vz), est.cfg.max_speed_mps * duty / 1000)
+        reach = stopping_distance_m(speed) + self.cfg.lane_margin_m
+        h, w = frame.left.shape[:2]
+        window = lane_window(self.geometry, (w, h), z, x, direction, reach)
+        if window is None:
+            return ""
+        disp = match_window(frame.left, frame.right, self.params, window)
+        if self.last_pair is not None:  # the robot's own body (its texture mismatches)
+            x0, y0, x1, y1 = self._robot_region(self.last_pair, frame.left.shape)
+            disp[y0:y1, x0:x1] = np.nan
+        found = lane_obstacle(disp, self.geometry, z, x, direction, reach, self.reference_map)
+        if found is None:
+            return ""
+        return f"an object in the lane {found.ahead_m:.2f} m ahead"
+
+    # -------------------------------------------------------------------- acquisition
+
+    def _widen_tolerance(self, sd: float) -> None:
+        """Widen a tolerance below the depth noise at the target (sd: px a frame)."""
         assert self.controller is not None
         cfg = self.controller.cfg
-        sd = float(np.std(self._noise, ddof=1))
         z = self.controller.target_m
         sigma_z = z * z * sd / (self.geometry.focal_px * self.geometry.baseline_m)
         # the controller decides on a line fitted through fit_frames: its end point has about
@@ -309,84 +381,132 @@ class Servo:
             self.notes.append(f"tolerance {cfg.tolerance_m * 100:.1f} cm is below the depth "
                               f"noise at the target ({sigma_z * 100:.2f} cm a frame at "
                               f"{z:.2f} m): widened to {floor * 100:.1f} cm")
-            self.controller.cfg = cfg.__class__(**{**cfg.__dict__, "tolerance_m": floor})
-        return False
+            self.controller.cfg = dataclasses.replace(cfg, tolerance_m=floor)
 
-    @property
-    def tolerance_m(self) -> float:
+    def _acquire(self, t: float, position: tuple[float, float] | None, d: float) -> Command:
+        """A frame of the acquisition: find, measure, probe."""
+        acq = self.acquisition
+        before = acq.phase
+        noise_m = 0.0
+        if position is not None:
+            noise_m = self.estimator.sigma_px * position[0] ** 2 / (
+                self.geometry.focal_px * self.geometry.baseline_m)
+            if acq.phase == "measure":  # probe the way the robot must go if it faces away
+                assert self.controller is not None
+                acq.direction = 1 if position[0] < self.controller.target_m else -1
+        order = acq.update(t, position, None if position is None else d, noise_m)
+        if acq.fault:
+            self.stop_reason = acq.fault
+        if before == "measure" and acq.phase != "measure":
+            sd = acq.noise_px()
+            self.estimator.sigma_px = max(0.05, sd)
+            self._widen_tolerance(sd)
+        if acq.done:
+            assert self.controller is not None and acq.facing_away is not None
+            self.controller.facing_away = acq.facing_away
+            if not acq.facing_away:
+                self.notes.append("the probe move showed that the robot faces the camera")
+        return Command(order.left, order.right, order.phase, None)
+
+    # ---------------------------------------------------------------------- the motion
+
+    def _check_motion(self, t: float, admitted: bool) -> None:
+        """The depth against the command in force since the last frame: against it, the
+        robot faces the other way (the controller turns it round); driven without moving,
+        the run stops."""
         assert self.controller is not None
-        return self.controller.cfg.tolerance_m
+        c = self.controller
+        kind = self.estimator.motion(t, self._cmd.left, self._cmd.right, c.facing_away,
+                                     admitted)
+        if kind == AGAINST:
+            self.flips += 1
+            if self.flips > MAX_FLIPS:
+                self.stop_reason = AGAINST_REASON
+                return
+            c.facing_away = not c.facing_away
+            c.history.clear()
+            self.notes.append("the depth moved against the commanded direction: the robot "
+                              "faces the other way")
+        elif kind == STILL:
+            self.stop_reason = STILL_REASON
 
     # ----------------------------------------------------------------------------- step
 
     def step(self, truth_depth_m: float = math.nan) -> LogRow:
         """One frame of the robot phase: perceive, decide, command, log."""
-        assert self.controller is not None and self.target is not None
-        assert self._strips is not None
+        assert self.controller is not None and self.tracker is not None
         last = self.rows[-1] if self.rows else None
         frame = self._frame()
         t_wall = time.perf_counter()
+        frozen = self.frozen.update(frame)
         frame = self._exposed(frame)
-        invalid = self._timing(frame)
-        pair = find_marker(frame.left, frame.right, self.marker, self.marker_radius_m,
-                           self.geometry.baseline_m, self.last_pair)
-        robot = block = math.nan
-        lateral = None
-        disp, rows = None, (0, 0)
+        t = frame.t_left
+        invalid = self.timing.check(self.clock(), t, frame.t_right) or frozen
+        seen = self._see(frame)
+        pair = seen.pair
+        position = None
         if pair is not None:
-            block, disp, rows = self._robot_disparity(frame, pair)
-            if math.isfinite(block) and abs(block - pair.disparity) > self.max_mismatch_px:
-                self.mismatches += 1  # two blobs that are not the marker's two views
-                pair = None
-            else:
-                self.last_pair = pair
-                robot = self._skew_corrected(frame, pair)
-                lateral = self.geometry.baseline_m * (pair.left.u - self.geometry.cx) / robot
-        due = self._remeasure_t is None or frame.t_left - self._remeasure_t >= self.remeasure_s
-        if due:
-            self._remeasure_t = frame.t_left
-        if due or self._strips.busy:  # a band of the re-measure's map each frame, then the map
-            # the robot must be left out of the scene: with its marker unseen this frame, the
-            # last place it was seen (it stops when the marker is lost); never seen: skip
-            robot_at = pair or self.last_pair
-            if self.controller.phase == "turn" or robot_at is None:
-                self._strips.reset()
-            else:
-                hide = self._robot_region(robot_at, frame.left.shape)
-                whole = self._strips.add(frame.left, frame.right, hide)
-                if whole is not None:
-                    self._remeasure(whole)
-        seen = pair is not None and not invalid
-        stop_reason = self.stop_reason  # read once: a STOP requested meanwhile acts next frame
-        if stop_reason:
-            cmd = Command(0, 0, "stop", None)
-        elif seen and self._measuring:
-            self._measuring = self._noise_phase(robot)
-            cmd = Command(0, 0, "measure", None)
-        else:
-            depth = self.geometry.depth_m(robot) if seen else None
-            aspect = pair.left.aspect if pair is not None else 1.0
-            cmd = self.controller.update(Observation(frame.t_left, depth, lateral, aspect,
-                                                     invalid))
-            if self.controller.fault:  # it cannot go on: the run ends here
-                self.stop_reason = stop_reason = self.controller.fault
+            self.last_pair = pair
+            seen.disparity = self.timing.skew_free(t, frame.t_right, pair.disparity,
+                                                   pair.right.u)
+            sighting = dataclasses.replace(self._sighting(t, pair), disparity=seen.disparity)
+            if not invalid:
+                self.estimator.accept(sighting)
+                position = self.estimator.position(sighting)
+        elif seen.rejected:
+            self.estimator.reject(t, seen.rejected)
+        self._remeasure_band(frame, pair)
+        if self.estimator.outside_too_long(t) and not self.stop_reason:
+            self.stop_reason = f"{OUTSIDE} ({self.estimator.why})"
+        cmd = self._decide(t, pair, position, seen.disparity, invalid)
+        if not cmd.is_stop and cmd.phase in ("drive", "creep", "probe"):
+            blocked = self._lane_blocked(frame)
+            if blocked:  # the controller learns that it stood (its creep floor must not rise)
+                cmd = Command(0, 0, "obstacle", cmd.error_m)
+                assert self.controller is not None
+                self.controller.phase = "obstacle"
+                invalid = invalid or blocked
         t_send = time.perf_counter()
         self._send(cmd)
         rtt_ms = (time.perf_counter() - t_send) * 1000
-        hz = (1.0 / (frame.t_left - last.t) if last is not None and frame.t_left > last.t
-              else math.nan)
-        reason = stop_reason or (invalid if invalid else
-                                      "marker not seen" if cmd.is_stop and pair is None else "")
-        depth_m = self.geometry.depth_m(robot) if math.isfinite(robot) else math.nan
-        row = LogRow(frame.t_left, cmd.phase, reason, self.target_m, depth_m,
+        self._cmd = cmd
+        self.estimator.commanded(t, cmd.left, cmd.right)
+        hz = 1.0 / (t - last.t) if last is not None and t > last.t else math.nan
+        reason = self.stop_reason or invalid or (
+            ("marker not seen" if not seen.rejected else f"marker refused: {seen.rejected}")
+            if cmd.is_stop and pair is None else "")
+        depth_m = self.geometry.depth_m(seen.disparity) if position is not None else math.nan
+        assert self.target is not None
+        row = LogRow(t, cmd.phase, reason, self.target_m, depth_m,
                      math.nan if cmd.error_m is None else cmd.error_m, self.target.disparity,
-                     robot, block, cmd.left, cmd.right, hz,
-                     (time.perf_counter() - t_wall) * 1000,
-                     (frame.t_right - frame.t_left) * 1000, truth_depth_m)
+                     seen.disparity if position is not None else math.nan, seen.block,
+                     cmd.left, cmd.right, hz, (time.perf_counter() - t_wall) * 1000,
+                     (frame.t_right - t) * 1000, truth_depth_m)
         self.rows.append(row)
-        self.last = Step(frame, disp, rows, self.target, pair, row)
-        self._notify(frame, cmd.phase, reason, disp, rows[0], pair, row, rtt_ms)
+        self.last = Step(frame, seen.disp, seen.rows, self.target, pair, row)
+        self._notify(frame, cmd.phase, reason, seen.disp, seen.rows[0], pair, row, rtt_ms)
         return row
+
+    def _decide(self, t: float, pair: MarkerPair | None,
+                position: tuple[float, float] | None, d: float, invalid: str) -> Command:
+        """This frame's command from the acquisition or the controller."""
+        assert self.controller is not None
+        if self.stop_reason:  # read once: a STOP requested meanwhile acts next frame
+            return Command(0, 0, "stop", None)
+        if not self.acquisition.done:
+            if invalid:
+                return Command(0, 0, "stale", None)
+            cmd = self._acquire(t, position, d)
+            return Command(0, 0, "stop", None) if self.stop_reason else cmd
+        self._check_motion(t, position is not None)
+        if self.stop_reason:
+            return Command(0, 0, "stop", None)
+        depth, lateral = position if position is not None else (None, None)
+        aspect = pair.left.aspect if pair is not None else 1.0
+        cmd = self.controller.update(Observation(t, depth, lateral, aspect, invalid))
+        if self.controller.fault:  # it cannot go on: the run ends here
+            self.stop_reason = self.controller.fault
+        return cmd
 
     def _send(self, cmd: Command) -> None:
         if cmd.is_stop:

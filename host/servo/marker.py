@@ -157,12 +157,12 @@ def _window(blob: Blob, shape: tuple[int, ...]) -> tuple[int, int, int, int]:
             min(w, int(blob.u) + reach + 1), min(h, int(blob.v) + reach + 1))
 
 
-def find_marker(left: np.ndarray, right: np.ndarray, kind: str = "disc",
-                radius_m: float | None = None, baseline_m: float | None = None,
-                near: MarkerPair | None = None) -> MarkerPair | None:
-    """The marker: among the candidates whose size fits their distance (a disc of radius_m at
-    disparity d spans radius_m * d / baseline_m px; within 35%), the one nearest to the last
-    sighting `near` (searched for around it first), else the largest. The neighbourhood the
+def marker_candidates(left: np.ndarray, right: np.ndarray, kind: str = "disc",
+                      radius_m: float | None = None, baseline_m: float | None = None,
+                      near: MarkerPair | None = None, whole: bool = False) -> list[MarkerPair]:
+    """Marker pairs whose size fits their distance (a disc of radius_m at disparity d spans
+    radius_m * d / baseline_m px; within 35%), best first: nearest to the last sighting `near`
+    (searched for around it first, unless whole), else the largest. The neighbourhood the
     disc must be darker than grows with the disc: from the last sighting, or at 31 px and then,
     if nothing is found, 121 px (a marker near the camera)."""
     def fits(p: MarkerPair) -> bool:
@@ -172,7 +172,7 @@ def find_marker(left: np.ndarray, right: np.ndarray, kind: str = "disc",
         return abs(p.left.radius - expected) <= 0.35 * expected
 
     pairs = []
-    if near is not None:
+    if near is not None and not whole:
         windows = (_window(near.left, left.shape), _window(near.right, right.shape))
         size = max(31, 2 * int(3 * near.left.radius) + 1)
         pairs = [p for p in find_markers(left, right, kind, windows=windows, window=size)
@@ -181,12 +181,18 @@ def find_marker(left: np.ndarray, right: np.ndarray, kind: str = "disc",
         if pairs:
             break
         pairs = [p for p in find_markers(left, right, kind, window=size) if fits(p)]
-    if not pairs:
-        return None
     if near is not None:
-        return min(pairs, key=lambda p: abs(p.left.u - near.left.u) + abs(p.left.v - near.left.v)
-                   + 10 * abs(p.disparity - near.disparity))
-    return max(pairs, key=lambda p: p.left.radius)
+        return sorted(pairs, key=lambda p: abs(p.left.u - near.left.u)
+                      + abs(p.left.v - near.left.v) + 10 * abs(p.disparity - near.disparity))
+    return sorted(pairs, key=lambda p: -p.left.radius)
+
+
+def find_marker(left: np.ndarray, right: np.ndarray, kind: str = "disc",
+                radius_m: float | None = None, baseline_m: float | None = None,
+                near: MarkerPair | None = None) -> MarkerPair | None:
+    """The best of marker_candidates, None if there is none."""
+    pairs = marker_candidates(left, right, kind, radius_m, baseline_m, near)
+    return pairs[0] if pairs else None
 
 
 def block_disparity(disp: np.ndarray, blob: Blob) -> float:

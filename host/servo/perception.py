@@ -147,12 +147,17 @@ def nearest_object(disp: np.ndarray, min_area: int, step: float = 0.5,
     return Target(float(q2), int(stats[best, cv2.CC_STAT_AREA]), (x, y, w, h), float(q3 - q1))
 
 
-def reference_target(disps: list[np.ndarray], min_area: int) -> tuple[Target, Floor | None]:
-    """Target from several disparity maps of the scene without the robot (per-pixel median)."""
+def median_map(disps: list[np.ndarray]) -> np.ndarray:
+    """The per-pixel median of several disparity maps (px, NaN where every map has none)."""
     stack = np.stack(disps)
     with np.errstate(all="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # pixels invalid in every map stay NaN
-        median = np.nanmedian(stack, axis=0) if len(disps) > 1 else stack[0]
+        return np.nanmedian(stack, axis=0) if len(disps) > 1 else stack[0]
+
+
+def reference_target(disps: list[np.ndarray], min_area: int) -> tuple[Target, Floor | None]:
+    """Target from several disparity maps of the scene without the robot (per-pixel median)."""
+    median = median_map(disps)
     floor = fit_floor(median)
     return nearest_object(without_floor(median, floor), min_area), floor
 

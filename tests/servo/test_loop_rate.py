@@ -70,26 +70,28 @@ def test_matchers_that_are_not_row_local_get_the_whole_map_in_one_frame(matcher:
 
 
 def test_no_frame_of_the_robot_phase_matches_more_than_one_band(monkeypatch) -> None:
+    """Each frame matches at most one band of the re-measure's map (whole rows, the full
+    search range), beside the marker's window and the lane ahead."""
     monkeypatch.setattr(perception, "STRIP_WORK", 1_000_000)  # four bands at 320x240 / 48
-    matched: list[int] = []
+    matched: list[tuple[int, int]] = []
 
     def counting(left, right, params):
-        matched.append(left.shape[0] * left.shape[1] * params.num_disparities)
+        matched.append((left.shape[1], params.num_disparities))
         return compute_disparity(left, right, params)
 
     with simulation(Setup((320, 240), 0.8)) as sim:
         assert sim.servo._strips is not None and sim.servo._strips.strips == 4
         monkeypatch.setattr(perception, "compute_disparity", counting)
         monkeypatch.setattr(loop, "compute_disparity", counting)
-        whole = 320 * 240 * 48
-        remeasures = 0
+        remeasures = bands = 0
         for _ in range(75):  # 2.5 s: two re-measures
             matched.clear()
-            before = sim.servo._target_history[:]
+            before = sim.servo.tracker.history[:]
             sim.step()
-            remeasures += sim.servo._target_history != before
-            assert sum(matched) < whole / 2  # a band of the map and the marker's window
-    assert remeasures >= 2
+            remeasures += sim.servo.tracker.history != before
+            assert matched.count((320, 48)) <= 1
+            bands += matched.count((320, 48))
+    assert remeasures >= 2 and bands >= 8
 
 
 def test_moved_target_is_followed_when_its_map_takes_several_frames(monkeypatch) -> None:

@@ -34,10 +34,14 @@ def test_robot_servoes_from_near_range() -> None:
 
 
 def test_a_run_that_never_sees_the_marker_is_not_held() -> None:
+    """It spins in place looking for its card, then stops with the reason."""
     with simulation(Setup((320, 240), 0.9, faults=WorldFaults())) as sim:
         sim.world.robot.marker_hidden = True
-        sim.run(2.0)
+        sim.run(15.0)
         outcome, reason = sim.servo.outcome()
         assert outcome == "stopped" and "never seen" in reason
-        assert {r.phase for r in sim.servo.rows} <= {"wait", "lost"}
+        assert sim.servo.stop_reason == "the marker was never seen"
+        assert {r.phase for r in sim.servo.rows} <= {"wait", "find", "stop"}
+        assert abs(sim.world.robot.z_m - 0.9) < 0.01  # in place
+        sim.run(sim.source.t + 0.5)
         assert sim.emulator.motors() == (0, 0)

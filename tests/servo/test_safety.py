@@ -13,7 +13,7 @@ from .simulation import simulation
 
 def test_hidden_marker_stops_the_robot_within_one_frame() -> None:
     with simulation(0.75) as sim:
-        for _ in range(15):
+        for _ in range(30):  # past the measure and the probe move
             sim.servo.step(sim.world.robot.z_m)
         assert sim.servo.rows[-1].phase in ("drive", "creep") and sim.emulator.motors() != (0, 0)
         sim.world.robot.marker_hidden = True

@@ -47,7 +47,7 @@ class Steady:
 def test_a_gap_between_capture_times_is_stale_even_on_a_steady_processing_clock() -> None:
     with simulation(Setup((320, 240), 0.7)) as sim:
         sim.servo.clock = Steady()
-        for _ in range(20):
+        for _ in range(30):  # past the measure and the probe move
             row = sim.servo.step()
         assert row.phase in ("drive", "creep") and sim.emulator.motors() != (0, 0)
         sim.source.run_ms(400)  # the camera delivers nothing for 0.4 s; the robot drives on
@@ -58,7 +58,7 @@ def test_a_gap_between_capture_times_is_stale_even_on_a_steady_processing_clock(
 
 def test_a_pair_captured_too_far_apart_is_not_used() -> None:
     with simulation(Setup((320, 240), 0.7)) as sim:
-        for _ in range(20):
+        for _ in range(30):  # past the measure and the probe move
             row = sim.servo.step()
         assert row.phase in ("drive", "creep")
         read = sim.source.read

@@ -1,0 +1,127 @@
+"""Before the control law drives: find the marker, measure its noise standing, and learn which
+way the robot faces by what a short probe move does (a pure state machine, one call a frame).
+
+    find     the marker not seen yet: stand find_wait_s, then spin in place (search_duty) until
+             it is seen, for at most find_s (a robot started at 60 or 90 degrees shows its card
+             edge-on)
+    measure  standing, noise_frames sightings of its disparity (their spread is the noise)
+    probe    both wheels at probe_duty (raised by probe_step every probe_step_s), forward or
+             backward (direction: the way the robot must go if it faces away), until
+             the marker has moved probe_m (and three times its noise, the median of the last
+             five sightings against the first five's): the way it faces follows,
+             else toward it; nothing moved by probe_s: the run stops with that reason
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+FIND, MEASURE, PROBE, DONE = "find", "measure", "probe", "done"
+NEVER_SEEN = "the marker was never seen"
+NOT_MOVED = "the marker did not move when the robot was driven"
+
+
+@dataclass(frozen=True)
+class AcquireConfig:
+    find_wait_s: float = 1.0
+    find_s: float = 10.0  # more than a whole turn at search_duty
+    search_duty: int = 260
+    noise_frames: int = 8
+    probe_duty: int = 300
+    probe_step: int = 100
+    probe_step_s: float = 0.5
+    max_probe_duty: int = 400
+    probe_m: float = 0.02
+    probe_s: float = 1.5  # a robot that can move has moved by then
+
+
+@dataclass(frozen=True)
+class Order:
+    """What acquisition asks of the wheels this frame (permille), and the phase."""
+
+    left: int
+    right: int
+    phase: str
+
+
+class Acquisition:
+    def __init__(self, config: AcquireConfig = AcquireConfig()) -> None:
+        self.cfg = config
+        self.phase = FIND if config.noise_frames > 0 else DONE
+        self.disparities: list[float] = []  # the standing robot's, for its noise
+        self.facing_away: bool | None = None  # learnt by the probe (None: not yet)
+        self.fault = ""  # why the run must end, "" if none
+        self._t0: float | None = None  # when the phase began
+        self._track: list[tuple[float, float, float]] = []  # (t, z, x) in the probe
+        self.direction = 1  # the probe's: +1 forward, -1 backward (set by the servo)
+
+    @property
+    def done(self) -> bool:
+        return self.phase == DONE
+
+    def update(self, t: float, position: tuple[float, float] | None,
+               disparity: float | None, noise_m: float = 0.0) -> Order:
+        """The frame at t: the robot's (depth, lateral) in m from the accepted sighting and
+        its disparity (px), or None when it was not seen; noise_m: a sighting's depth noise
+        (m, standard deviation; the probe's move must be well beyond it)."""
+        if self._t0 is None:
+            self._t0 = t
+        if self.phase == FIND:
+            return self._find(t, position is not None)
+        if self.phase == MEASURE:
+            if disparity is not None:
+                self.disparities.append(disparity)
+                if len(self.disparities) >= self.cfg.noise_frames:
+                    self._begin(PROBE, t)
+            return Order(0, 0, MEASURE)
+        if self.phase == PROBE:
+            return self._probe(t, position, noise_m)
+        return Order(0, 0, DONE)
+
+    def _begin(self, phase: str, t: float) -> None:
+        self.phase, self._t0 = phase, t
+
+    def _find(self, t: float, seen: bool) -> Order:
+        assert self._t0 is not None
+        if seen:
+            self._begin(MEASURE, t)
+            return Order(0, 0, MEASURE)
+        waited = t - self._t0
+        if waited < self.cfg.find_wait_s:
+            return Order(0, 0, "wait")
+        if waited > self.cfg.find_wait_s + self.cfg.find_s:
+            self.fault = NEVER_SEEN
+            return Order(0, 0, FIND)
+        d = self.cfg.search_duty
+        return Order(d, -d, FIND)
+
+    def _probe(self, t: float, position: tuple[float, float] | None, noise_m: float) -> Order:
+        assert self._t0 is not None
+        cfg = self.cfg
+        if position is None:
+            return Order(0, 0, PROBE)  # not seen: stand until it is
+        self._track.append((t, *position))
+        if len(self._track) >= 10:
+            # the move so far: the median of the last five sightings against the first five's
+            # (one wild sighting decides nothing), beyond three of a sighting's noise
+            first, last = self._track[:5], self._track[-5:]
+            dz = float(np.median([p[1] for p in last]) - np.median([p[1] for p in first]))
+            dx = float(np.median([p[2] for p in last]) - np.median([p[2] for p in first]))
+            if math.hypot(dz, dx) >= max(cfg.probe_m, 3 * noise_m):
+                self.facing_away = (dz > 0) == (self.direction > 0)
+                self._begin(DONE, t)
+                return Order(0, 0, PROBE)
+        if t - self._t0 > cfg.probe_s:
+            self.fault = NOT_MOVED
+            return Order(0, 0, PROBE)
+        duty = min(cfg.max_probe_duty,
+                   cfg.probe_duty + cfg.probe_step * int((t - self._t0) / cfg.probe_step_s))
+        duty *= self.direction
+        return Order(duty, duty, PROBE)
+
+    def noise_px(self) -> float:
+        """The standing robot's disparity noise a frame (px, standard deviation)."""
+        return float(np.std(self.disparities, ddof=1)) if len(self.disparities) > 1 else 0.0

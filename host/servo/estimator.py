@@ -1,0 +1,243 @@
+"""The robot's state from its marker, never from one reading: every sighting is gated against
+where the robot can be, given what it was commanded since the last one it trusted, and its
+motion is checked against the commands (a pure state machine, one call per frame).
+
+State: depth z and lateral position x (m, camera frame: z along the optical axis, x to the
+right) and their rates, an alpha-beta filter on the sightings it accepts. The gate of a new
+sighting is the reach of the robot since the last accepted one: nothing while it was told to
+stand but a slow drift (a push, a slope) and the run-down of its last motion; what its duties
+allow while it was told to move (max_speed_mps at full duty; a spin in place only the share
+unequal wheels turn into travel); always margin_m (the card's offset from the turn axis, blur)
+and sigmas times the sighting's own noise (depth noise grows as z^2). Its size
+must fit its disparity: the disc's vertical radius against the ratio learnt from the accepted
+sightings. A sighting outside the gate is not used; seen only outside it for outlier_stop_s,
+the run stops with that reason.
+
+Motion check: while the robot is driven straight one way, its depth must move that way. Moved
+against_m (and three of a sighting's noise; medians of five) the other way, the robot faces
+the other way than assumed ("against"); driven at still_duty or more for still_s without the
+marker moving ("still"), what is seen is not the robot moving (a marker painted on the wall, a
+frozen picture, a stuck robot).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from host.camera.calibration import Geometry
+
+AGAINST, STILL = "against", "still"
+OUTSIDE = "the marker is seen only where the robot cannot be"
+
+
+@dataclass(frozen=True)
+class EstimatorConfig:
+    max_speed_mps: float = 0.4  # the robot's speed at full duty, with room
+    drift_mps: float = 0.03  # motion while told to stand (a push, a slope)
+    run_down_s: float = 0.35  # actuation latency and the wheels' run-down after a stop
+    margin_m: float = 0.04  # always allowed: the card's offset from the turn axis, blur
+    sigmas: float = 5.0  # a sighting's own noise allowed, in standard deviations
+    size_tolerance: float = 0.3  # the disc's radius against its disparity, relative
+    outlier_stop_s: float = 2.0
+    alpha: float = 0.5  # the filter's position and rate gains per accepted sighting
+    beta: float = 0.05
+    spin_share: float = 0.15  # of a spin's duty that unequal wheels may turn into travel
+    settle_s: float = 0.3  # a command's effect shows this long after it (latency and lag)
+    against_m: float = 0.025
+    still_s: float = 1.0
+    still_duty: int = 350
+    still_m: float = 0.015
+
+
+@dataclass(frozen=True)
+class Sighting:
+    """One marker sighting: its capture time (s), disparity (px, skew-free), left-image column
+    (px) and the disc's vertical radius (px)."""
+
+    t: float
+    disparity: float
+    u: float
+    radius_px: float
+
+
+@dataclass
+class _State:
+    t: float
+    z: float
+    x: float
+    vz: float = 0.0
+    vx: float = 0.0
+
+
+class Estimator:
+    def __init__(self, geometry: Geometry, config: EstimatorConfig = EstimatorConfig(),
+                 sigma_px: float = 0.1) -> None:
+        self.g, self.cfg = geometry, config
+        self.sigma_px = sigma_px  # the disparity's noise a frame (px), from the noise phase
+        self.state: _State | None = None
+        self.rejected = 0  # sightings rejected since the last accepted one
+        self.why = ""  # why the last sighting was rejected
+        self._ratios: list[float] = []  # accepted radius / disparity
+        self._moving_s = 0.0  # time told to go since the last accepted sighting
+        self._travel_m = 0.0  # the most its commands since then can have moved it
+        self._cmd: tuple[float, int, int] | None = None  # the command in force since t
+        self._outside_since: float | None = None
+        self._segment: list[tuple[float, float, float]] = []  # (t, z, x) while driven one way
+        self._segment_cmd: tuple[int, bool] = (0, False)  # its direction, duty >= still
+        self._segment_t0 = 0.0
+
+    # --------------------------------------------------------------------------- metres
+
+    def position(self, s: Sighting) -> tuple[float, float]:
+        """(depth, lateral) in metres of a sighting."""
+        z = self.g.depth_m(s.disparity)
+        return z, self.g.baseline_m * (s.u - self.g.cx) / s.disparity
+
+    # ---------------------------------------------------------------------- prediction
+
+    def commanded(self, t: float, left: int, right: int) -> None:
+        """The command sent at t (permille per wheel), in force until the next one."""
+        self._account(t)
+        self._cmd = (t, left, right)
+
+    def _account(self, t: float) -> None:
+        """Add the command in force since its time up to t to the travel allowed."""
+        if self._cmd is None:
+            return
+        t0, left, right = self._cmd
+        dt = max(0.0, t - t0)
+        ahead, spin = abs(left + right) / 2, abs(left - right) / 2
+        if ahead > spin:  # told to go (a spin in place goes nowhere)
+            self._moving_s += dt
+        # the most it can go: full speed at full duty, and unequal wheels' share of a spin
+        self._travel_m += self.cfg.max_speed_mps * (ahead + self.cfg.spin_share * spin) \
+            / 1000 * dt
+        self._cmd = (t, left, right)
+
+    def reach_m(self, t: float) -> float:
+        """How far (m) the robot can have gone from its last accepted sighting by t: its
+        motion then running down, what its commands since allow (and that motion running
+        down), a drift, and the margin."""
+        assert self.state is not None
+        cfg = self.cfg
+        self._account(t)
+        dt = max(0.0, t - self.state.t)
+        run_down = cfg.max_speed_mps * cfg.run_down_s if self._moving_s > 0 else 0.0
+        speed = math.hypot(self.state.vz, self.state.vx)
+        return (cfg.margin_m + self._travel_m + run_down + cfg.drift_mps * dt
+                + speed * min(dt, cfg.run_down_s))
+
+    def predicted(self, t: float) -> tuple[float, float]:
+        """(depth, lateral) in metres expected at t: the last accepted position moved on at the
+        filtered rate while the robot was told to go, and as its motion ran down."""
+        assert self.state is not None
+        s = self.state
+        dt = min(max(0.0, t - s.t), self._moving_s + self.cfg.run_down_s)
+        return s.z + s.vz * dt, s.x + s.vx * dt
+
+    # --------------------------------------------------------------------------- gating
+
+    def gate(self, s: Sighting) -> str:
+        """Why the sighting cannot be the robot ("" if it can)."""
+        z, x = self.position(s)
+        if self._ratios and len(self._ratios) >= 5:
+            ratio = float(np.median(self._ratios))
+            if abs(s.radius_px / s.disparity - ratio) > self.cfg.size_tolerance * ratio:
+                return (f"its size ({s.radius_px:.1f} px) does not fit its disparity "
+                        f"({s.disparity:.1f} px)")
+        if self.state is None:
+            return ""
+        zp, xp = self.predicted(s.t)
+        noise = self.cfg.sigmas * self.sigma_px * z * z / (self.g.focal_px * self.g.baseline_m)
+        reach = self.reach_m(s.t) + noise
+        jump = math.hypot(z - zp, x - xp)
+        if jump > reach:
+            return f"{jump:.2f} m from where the robot can be (within {reach:.2f} m)"
+        return ""
+
+    def reject(self, t: float, why: str) -> None:
+        """A sighting at t was outside the gate (why): it is not used."""
+        self.rejected += 1
+        self.why = why
+        if self._outside_since is None:
+            self._outside_since = t
+
+    def outside_too_long(self, t: float) -> bool:
+        """Whether the marker has been seen only outside the gate for outlier_stop_s."""
+        return self._outside_since is not None and t - self._outside_since >= \
+            self.cfg.outlier_stop_s
+
+    def accept(self, s: Sighting) -> None:
+        """Take a sighting that passed the gate into the state."""
+        z, x = self.position(s)
+        self._ratios.append(s.radius_px / s.disparity)
+        del self._ratios[:-30]
+        st = self.state
+        if st is None:
+            self.state = _State(s.t, z, x)
+        else:
+            dt = s.t - st.t
+            zp, xp = self.predicted(s.t)
+            a, b = self.cfg.alpha, self.cfg.beta
+            rz, rx = z - zp, x - xp
+            st.z, st.x = zp + a * rz, xp + a * rx
+            if 0 < dt <= 0.5:  # further apart, the rate is not known
+                top = self.cfg.max_speed_mps
+                st.vz = max(-top, min(top, st.vz + b * rz / dt))
+                st.vx = max(-top, min(top, st.vx + b * rx / dt))
+            else:
+                st.vz = st.vx = 0.0
+            st.t = s.t
+        self._account(s.t)
+        self._moving_s = self._travel_m = 0.0
+        self.rejected = 0
+        self.why = ""
+        self._outside_since = None
+
+    def forget(self) -> None:
+        """Drop the state (a re-acquisition): the next sighting is taken as it comes."""
+        self.state = None
+        self._ratios.clear()
+        self._outside_since = None
+        self._segment.clear()
+
+    # ---------------------------------------------------------------------- motion check
+
+    def motion(self, t: float, left: int, right: int, facing_away: bool,
+               accepted: bool) -> str:
+        """Check the motion under the command (left, right) in force at t: "against" when the
+        depth moved against the commanded direction, "still" when driven without moving, else
+        "". accepted: the frame's sighting was accepted (the state is this frame's)."""
+        straight = left * right > 0 and abs(left - right) < abs(left + right)
+        sign = (1 if left > 0 else -1) * (1 if facing_away else -1) if straight else 0
+        duty = min(abs(left), abs(right)) if straight else 0
+        key = (sign, duty >= self.cfg.still_duty)
+        if sign == 0 or key != self._segment_cmd:
+            self._segment.clear()
+            self._segment_cmd = key
+            self._segment_t0 = t
+        if sign == 0 or not accepted or self.state is None:
+            return ""
+        if t - self._segment_t0 < self.cfg.settle_s:
+            return ""
+        self._segment.append((t, self.state.z, self.state.x))
+        seg = self._segment
+        if len(seg) < 10:
+            return ""
+        # the median of the last five against the first five's: one wild sighting decides
+        # nothing; the move must be beyond three of a sighting's noise too
+        z0, z1 = (float(np.median([p[1] for p in part])) for part in (seg[:5], seg[-5:]))
+        dz = z1 - z0
+        noise = 3 * self.sigma_px * z1 * z1 / (self.g.focal_px * self.g.baseline_m)
+        if dz * sign < -max(self.cfg.against_m, noise):
+            self._segment.clear()
+            return AGAINST
+        if key[1] and seg[-1][0] - seg[0][0] >= self.cfg.still_s:
+            dx = max(p[2] for p in seg) - min(p[2] for p in seg)
+            if abs(dz) < self.cfg.still_m and dx < self.cfg.still_m:
+                self._segment.clear()
+                return STILL
+        return ""

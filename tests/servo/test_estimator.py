@@ -1,0 +1,77 @@
+"""The estimator on its own: a sighting the robot cannot have produced (a jump of metres or of
+tens of pixels in a frame, a size that does not fit its disparity) is refused; the gate is as
+wide as the commands since the last trusted sighting allow; the depth moving against the
+commanded direction, or not at all under a drive, is reported."""
+
+from __future__ import annotations
+
+import pytest
+
+from host.camera.calibration import Geometry
+from host.servo.estimator import AGAINST, STILL, Estimator, Sighting
+
+G = Geometry(426.0, 0.060, 160.0, 120.0)  # the simulated Minoru at 320x240
+FB = G.focal_px * G.baseline_m
+
+
+def sighting(t: float, z: float, x: float = 0.0, radius_px: float | None = None) -> Sighting:
+    d = FB / z
+    return Sighting(t, d, G.cx + x * d / G.baseline_m, radius_px or 0.5 * d)
+
+
+def standing(z: float = 1.26, frames: int = 10) -> Estimator:
+    est = Estimator(G)
+    for i in range(frames):
+        est.accept(sighting(i / 30, z))
+        est.commanded(i / 30, 0, 0)
+    return est
+
+
+def test_the_issues_false_marker_is_refused_and_the_true_one_admitted() -> None:
+    """The robot at 1.26 m (20 px); a blob at 8 px, 51 px away in the image, a frame later."""
+    est = standing()
+    t = 10 / 30
+    true = sighting(t, 1.26)
+    fake = Sighting(t, 8.0, true.u + 51, 3.0)
+    assert "from where the robot can be" in est.gate(fake)
+    assert est.gate(true) == ""
+
+
+def test_a_jump_of_51_px_at_the_same_disparity_is_refused() -> None:
+    est = standing()
+    true = sighting(10 / 30, 1.26)
+    assert est.gate(Sighting(true.t, true.disparity, true.u + 51, true.radius_px)) != ""
+
+
+def test_standing_still_the_gate_stays_narrow_and_driving_widens_it() -> None:
+    est = standing(1.0)
+    far = sighting(2.0, 1.25)  # 25 cm on, 1.7 s after the last trusted sighting
+    assert est.gate(far) != ""  # told to stand: it cannot have gone 25 cm
+    moved = standing(1.0)
+    moved.commanded(10 / 30, 600, 600)  # told to drive since
+    assert moved.gate(far) == ""
+
+
+def test_a_disc_whose_size_does_not_fit_its_disparity_is_refused() -> None:
+    est = standing(1.26)
+    t = 10 / 30
+    assert est.gate(sighting(t, 1.26, radius_px=0.5 * FB / 1.26)) == ""
+    assert "size" in est.gate(sighting(t, 1.26, radius_px=0.25 * FB / 1.26))
+
+
+@pytest.mark.parametrize("facing_away, dz, want", [(True, +0.005, ""), (True, -0.005, AGAINST),
+                                                   (False, -0.005, ""), (False, +0.005, AGAINST),
+                                                   (True, 0.0, STILL)])
+def test_the_depth_must_move_the_way_the_robot_is_driven(facing_away: bool, dz: float,
+                                                          want: str) -> None:
+    """Driven forward at 500 for 1.5 s, the depth grows when the robot faces away from the
+    camera; moving the other way (or not at all) is reported."""
+    est = standing(1.0)
+    z, got = 1.0, ""
+    for i in range(10, 55):
+        t = i / 30
+        est.commanded(t, 500, 500)
+        z += dz
+        est.accept(sighting(t + 1 / 30, z))
+        got = got or est.motion(t + 1 / 30, 500, 500, facing_away, True)
+    assert got == want
