@@ -14,6 +14,7 @@ from host.errors import HostError
 from host.stereo import block_matching as bm
 from host.stereo import sad, sgm
 from host.stereo.grey import to_grey
+from host.stereo.heap import keep_freed_blocks
 from host.stereo.opencv_backend import opencv_disparity
 from host.stereo.params import MatcherParams
 from host.stereo.postprocess import fill_background, lr_consistency, median
@@ -25,6 +26,7 @@ SGM_P2 = 32
 # thread alone: waking numba's thread pool costs more than it saves there, and on a loaded
 # machine a sleeping worker took 7-40 ms to join a 0.2 ms match of the servo's marker window
 SERIAL_WORK = 1 << 21
+keep_freed_blocks()  # per-call arrays reuse the last call's memory (heap.py)
 
 
 @contextlib.contextmanager
