@@ -321,7 +321,7 @@ def _sweep(cl, crrev, vol, S, P, M, crow, tot, forward, i0, i1, p1, p2, diagonal
     direction's paths: path 0 from behind in the row, 2 from the row before at the same x,
     and (diagonals) 1 and 3 from the row before at x - step and x + step.
 
-    P (2 row parities, 5 path slots, cols, nd + 2) and M (2, 5, cols) carry the path costs from
+    P (2 row parities, 4 path slots, cols, nd + 2) and M (2, 4, cols) carry the path costs from
     row to row, so one direction can stop at a row and go on from it in a later call. Without
     finish the row's path sum goes into S; with finish it is added to S's row (the other
     direction's sum) into tot and decided (and, with keep, stored back into S).
@@ -449,6 +449,22 @@ def _down(cl, crrev, vol, S, P, M, crow, tot, y0, y1, warm, p1, p2, dmin, unique
             S[y] = tot
 
 
+@njit(cache=True)
+def _buffers(n, w, nd):
+    """n sets of the state one direction or stripe carries: rows of path costs P (2 row
+    parities, 4 path slots, cols, nd + 2, PAD at both ends) and their minima M, a cost row, a
+    row of totals, and the right view's minima (uint32 and uint16 packings)."""
+    P = np.empty((n, 2, 4, w, nd + 2), dtype=np.uint16)
+    P[:, :, :, :, 0] = PAD
+    P[:, :, :, :, nd + 1] = PAD
+    M = np.zeros((n, 2, 4, w), dtype=np.uint16)
+    crow = np.empty((n, w, nd), dtype=np.uint16)
+    tot = np.empty((n, w, nd), dtype=np.uint16)
+    acc = np.empty((n, w + nd), dtype=np.uint32)
+    acc16 = np.empty((n, w + nd), dtype=np.uint16)
+    return P, M, crow, tot, acc, acc16
+
+
 @njit(cache=True, parallel=True)
 def match(cl, crrev, vol, S, dmin, p1, p2, paths, uniqueness, fit, want_right, keep):
     """Semi-global matching of census images cl and crrev (see _cost_row): disparity maps of
@@ -469,14 +485,6 @@ def match(cl, crrev, vol, S, dmin, p1, p2, paths, uniqueness, fit, want_right, k
     """
     h, w = cl.shape
     nd = S.shape[2]
-    P = np.empty((2, 2, 5, w, nd + 2), dtype=np.uint16)
-    P[:, :, :, :, 0] = PAD
-    P[:, :, :, :, nd + 1] = PAD
-    M = np.zeros((2, 2, 5, w), dtype=np.uint16)
-    crow = np.empty((2, w, nd), dtype=np.uint16)
-    tot = np.empty((2, w, nd), dtype=np.uint16)
-    acc = np.empty((2, w + nd), dtype=np.uint32)
-    acc16 = np.empty((2, w + nd), dtype=np.uint16)
     # a path cost is at most the largest cost + P2, so every total is under paths times that:
     # if it fits with the candidate's bits below it, the right view's minimum runs in uint16
     bits = 0
@@ -489,11 +497,15 @@ def match(cl, crrev, vol, S, dmin, p1, p2, paths, uniqueness, fit, want_right, k
     upper = (h + 1) // 2
     if paths == 5:
         for k in prange(2):
+            # each stripe's rows of path costs are its own: on one thread the second stripe
+            # reuses the first one's memory, so the peak holds one set
+            P, M, crow, tot, acc, acc16 = _buffers(1, w, nd)
             y0, y1 = (0, upper) if k == 0 else (upper, h)
-            _down(cl, crrev, vol, S, P[k], M[k], crow[k], tot[k], y0, y1,
+            _down(cl, crrev, vol, S, P[0], M[0], crow[0], tot[0], y0, y1,
                   0 if k == 0 else min(OVERLAP, upper), p1, p2, dmin, uniqueness, fit,
-                  want_right, disp_l, disp_r, acc[k], acc16[k], sh, keep)
+                  want_right, disp_l, disp_r, acc[0], acc16[0], sh, keep)
         return disp_l, disp_r
+    P, M, crow, tot, acc, acc16 = _buffers(2, w, nd)  # the directions go on from row to row
     diagonals = paths == 8
     for phase in range(2):
         for k in prange(2):
