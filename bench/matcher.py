@@ -1,20 +1,23 @@
 """Benchmark: own SAD against cv2.StereoBM and own SGM against cv2 SGBM 3WAY, side by side.
 
-Run with `make bench`. Each pair of matchers runs in blocks of back-to-back calls, the blocks
-alternating (own, OpenCV, own, ...) in one process, both on the same grey input with the same
-window and disparity range; a time is the median over blocks of the mean call time in a block,
-and the figure that matters is the ratio own / OpenCV. Thread counts are set for both sides
-(numba.set_num_threads, cv2.setNumThreads); the machine's load (`uptime`) is printed beside
-every figure, since other work on the machine moves absolute times. The SGM rows on one
-thread also give the ratio of process CPU time, which other work moves much less. Then
-quality on Cones and Teddy (Middlebury v2 metric, rho 1 px) and the sub-pixel fits compared.
+`python bench/matcher.py --help` lists the sections. Each pair of matchers runs in blocks of
+back-to-back calls, the blocks alternating (own, OpenCV, own, ...) in one process, on the same
+grey input (the Motorcycle pair resized) with the same window and disparity range; a time is
+the median over blocks of the mean call time in a block, and the figure that matters is the
+ratio own / OpenCV: as process CPU time on one thread (what the call costs a core, which other
+work on the shared machine moves little) and as wall time on two threads. The load average
+(`uptime`) is printed beside every row. Peak memory runs each matcher once in a fresh process.
+Then quality on Cones and Teddy (Middlebury v2 metric, rho 1 px) and the sub-pixel fits.
 """
 
 from __future__ import annotations
 
+import argparse
+import json
 import os
 import platform
 import statistics
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -30,20 +33,24 @@ from host.stereo.scenes import default_scene
 
 BLOCKS = 7
 CALL_MS = 300  # each block runs about this long
+# (width, height, disparities): the sizes and candidate counts of issue 24
+SIZES = [(320, 240, 32)] + [(640, 480, nd) for nd in (16, 32, 48, 56, 64, 96, 128)] + [
+    (1280, 960, 128)]
+MEMORY_SIZES = [(640, 480, 64), (2560, 1920, 256)]
 
 
 def load() -> str:
     return "load {:.2f} {:.2f} {:.2f}".format(*os.getloadavg())
 
 
-def _cpu_block(fn, calls: int) -> tuple[float, float]:
+def _block(fn, calls: int) -> tuple[float, float]:
     w0, c0 = time.perf_counter(), time.process_time()
     for _ in range(calls):
         fn()
     return ((time.perf_counter() - w0) * 1000 / calls, (time.process_time() - c0) * 1000 / calls)
 
 
-def side_by_side_cpu(own, ref) -> tuple[float, float, float, float]:
+def side_by_side_cpu(own, ref, blocks: int = BLOCKS) -> tuple[float, float, float, float]:
     """Two callables run in alternating blocks: (wall own, wall ref, CPU own, CPU ref), ms per
     call, medians over blocks (CPU: the process time). On one thread the CPU time is what the
     call would take on an idle core, so its ratio holds up when other work shares the machine."""
@@ -53,9 +60,9 @@ def side_by_side_cpu(own, ref) -> tuple[float, float, float, float]:
     ref()
     calls = max(2, int(CALL_MS / max(1.0, (time.perf_counter() - t0) * 1000)))
     a, b = [], []
-    for _ in range(BLOCKS):
-        a.append(_cpu_block(own, calls))
-        b.append(_cpu_block(ref, calls))
+    for _ in range(blocks):
+        a.append(_block(own, calls))
+        b.append(_block(ref, calls))
     med = [statistics.median(v[k] for v in x) for k in (0, 1) for x in (a, b)]
     return med[0], med[1], med[2], med[3]
 
@@ -70,42 +77,15 @@ def set_threads(n: int) -> None:
     cv2.setNumThreads(n)
 
 
-def pairs() -> list[tuple[str, np.ndarray, np.ndarray, int]]:
-    out = []
-    data = os.environ.get("STEREO_SERVO_DATA")
-    if data and (Path(data) / "middlebury" / "cones").is_dir():
-        c = load_scene(Path(data) / "middlebury" / "cones")
-        out.append(("Cones", to_grey(c.left), to_grey(c.right), 64))
+def opencv_range(nd: int) -> int:
+    """OpenCV's matchers take a multiple of 16 candidates: the least that covers nd."""
+    return -(-nd // 16) * 16
+
+
+def resized_pair(w: int, h: int) -> tuple[np.ndarray, np.ndarray]:
     moto = default_scene()
-    for (w, h), nd in (((640, 480), 64), ((1280, 960), 128)):
-        lr = [to_grey(cv2.resize(v, (w, h), interpolation=cv2.INTER_AREA))
-              for v in (moto.left, moto.right)]
-        out.append((f"Motorcycle {w}x{h}", lr[0], lr[1], nd))
-    return out
-
-
-def sad_vs_stereobm(window: int = 9) -> dict[tuple[str, int], float]:
-    print(f"\n## own SAD (default sub-pixel) / cv2.StereoBM, grey, window {window}")
-    own_ms = {}
-    for name, gl, gr, nd in pairs():
-        for threads in (1, 2):
-            set_threads(threads)
-            own = MatcherParams(matcher="sad", block_size=window, num_disparities=nd,
-                                colour=False)
-            warm_up(own)
-            bm = cv2.StereoBM_create(nd, window)
-            a, b = side_by_side(lambda: compute_disparity(gl, gr, own),  # noqa: B023
-                                lambda: bm.compute(gl, gr))  # noqa: B023
-            own_ms[(name, threads)] = a
-            print(f"{name:<22} {gl.shape[1]}x{gl.shape[0]} nd {nd:<4} threads {threads}  "
-                  f"own {a:7.2f} ms  StereoBM {b:7.2f} ms  ratio {a / b:5.2f}  ({load()})",
-                  flush=True)
-    big = [k for k in own_ms if k[0].endswith("1280x960")]
-    if len(big) == 2:
-        name = big[0][0]
-        print(f"thread scaling 1 -> 2 on {name}: own "
-              f"{own_ms[(name, 1)] / own_ms[(name, 2)]:.2f}x")
-    return own_ms
+    return tuple(to_grey(cv2.resize(v, (w, h), interpolation=cv2.INTER_AREA))
+                 for v in (moto.left, moto.right))
 
 
 SGBM_3WAY = MatcherParams(matcher="opencv-sgbm", mode="sgbm3way", block_size=3,
@@ -115,26 +95,93 @@ OWN_SGM = MatcherParams(matcher="sgm", block_size=1, lr_check=1.0, fill=True, bo
                         num_disparities=64)  # default paths (5)
 BEST_LOCAL = MatcherParams(matcher="ncc", block_size=5, border="clip", lr_check=1.0, fill=True,
                            median=5, num_disparities=64)
-
-
 SGM_PATHS = (5, 8, 4)  # the default first
+SAD_WINDOW = 9
 
 
-def sgm_vs_sgbm() -> None:
-    print("\n## own SGM (LR 1 + fill) / cv2 SGBM 3WAY (block 3, LR 1 + fill), grey")
-    for name, gl, gr, nd in pairs()[:2]:
-        for threads in (1, 2):
-            set_threads(threads)
-            for paths in SGM_PATHS:
-                own = OWN_SGM.replace(num_disparities=nd, paths=paths)
-                ref = SGBM_3WAY.replace(num_disparities=nd, colour=False)
-                a, b, ca, cb = side_by_side_cpu(
-                    lambda: compute_disparity(gl, gr, own),  # noqa: B023
-                    lambda: compute_disparity(gl, gr, ref))  # noqa: B023
-                cpu = f"  CPU {ca:6.1f} / {cb:6.1f} ms ratio {ca / cb:5.2f}" if threads == 1 else ""
-                print(f"{name:<22} {gl.shape[1]}x{gl.shape[0]} nd {nd:<4} threads {threads}  "
-                      f"paths {paths}  own {a:7.2f} ms  SGBM 3WAY {b:7.2f} ms  "
-                      f"ratio {a / b:5.2f}{cpu}  ({load()})", flush=True)
+def pair_params(kind: str, nd: int, paths: int = 5) -> tuple[MatcherParams, object]:
+    """(own params, OpenCV callable maker) for 'sad' or 'sgm' at nd candidates."""
+    if kind == "sad":
+        own = MatcherParams(matcher="sad", block_size=SAD_WINDOW, num_disparities=nd,
+                            colour=False)
+        return own, lambda gl, gr: (lambda bm=cv2.StereoBM_create(opencv_range(nd), SAD_WINDOW):
+                                    bm.compute(gl, gr))
+    own = OWN_SGM.replace(num_disparities=nd, paths=paths)
+    ref = SGBM_3WAY.replace(num_disparities=opencv_range(nd), colour=False)
+    return own, lambda gl, gr: (lambda: compute_disparity(gl, gr, ref))
+
+
+def speed(kind: str, paths: tuple[int, ...] = (5,)) -> None:
+    """Rows of own / OpenCV at every size: CPU time on one thread, wall time on two."""
+    other = "StereoBM" if kind == "sad" else "SGBM 3WAY"
+    what = (f"own SAD (window {SAD_WINDOW}, default sub-pixel) / cv2.StereoBM" if kind == "sad"
+            else "own SGM (window 1, clip, LR 1 + fill) / cv2 SGBM 3WAY (block 3, LR 1 + fill)")
+    print(f"\n## {what}, grey; CPU ms on 1 thread, wall ms on 2 threads")
+    for w, h, nd in SIZES:
+        gl, gr = resized_pair(w, h)
+        for pth in paths:
+            own, maker = pair_params(kind, nd, pth)
+            warm_up(own)
+            ref = maker(gl, gr)
+            cells = []
+            for threads in (1, 2):
+                set_threads(threads)
+                a, b, ca, cb = side_by_side_cpu(lambda: compute_disparity(gl, gr, own),  # noqa: B023
+                                                ref)
+                if threads == 1:
+                    cells.append(f"1 thread CPU {ca:6.1f} / {cb:6.1f} ms = {ca / cb:4.2f}")
+                else:
+                    cells.append(f"2 threads wall {a:6.1f} / {b:6.1f} ms = {a / b:4.2f}")
+            label = f"{w}x{h} / {nd}" + (f" ({other} {opencv_range(nd)})"
+                                         if opencv_range(nd) != nd else "")
+            label += f" paths {pth}" if kind == "sgm" else ""
+            print(f"{label:<34} " + "   ".join(cells) + f"   ({load()})", flush=True)
+    set_threads(2)
+
+
+PEAK = """
+import json, resource, sys
+import numpy as np
+import numba
+import cv2
+from host.stereo import MatcherParams, compute_disparity
+numba.set_num_threads(1)
+cv2.setNumThreads(1)
+w, h, p = int(sys.argv[1]), int(sys.argv[2]), MatcherParams(**json.loads(sys.argv[3]))
+rng = np.random.default_rng(0)
+small = rng.integers(0, 256, (48, 32 + p.num_disparities), dtype=np.uint8)
+compute_disparity(small, small, p.replace(num_disparities=16))  # load the kernels
+wide = rng.integers(0, 256, (h, w + 32), dtype=np.uint8)
+left, right = np.ascontiguousarray(wide[:, 32:]), np.ascontiguousarray(wide[:, :w])
+def rss():
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * resource.getpagesize()
+before = rss()
+compute_disparity(left, right, p)
+print((resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024 - before) / (w * h))
+"""
+
+
+def peak_bytes_per_pixel(p: MatcherParams, w: int, h: int) -> float:
+    """Peak resident memory a call adds, in bytes per pixel (a fresh process, one thread)."""
+    fields = {k: getattr(p, k) for k in ("matcher", "mode", "block_size", "num_disparities",
+                                         "lr_check", "fill", "border", "colour", "paths",
+                                         "uniqueness_ratio", "speckle_window_size",
+                                         "speckle_range")}
+    out = subprocess.run([sys.executable, "-c", PEAK, str(w), str(h), json.dumps(fields)],
+                         capture_output=True, text=True, check=True)
+    return float(out.stdout.split()[-1])
+
+
+def memory() -> None:
+    print("\n## peak memory a call adds (one thread, fresh process, random pair), B / pixel")
+    for w, h, nd in MEMORY_SIZES:
+        own = peak_bytes_per_pixel(OWN_SGM.replace(num_disparities=nd), w, h)
+        ref = peak_bytes_per_pixel(SGBM_3WAY.replace(num_disparities=nd, colour=False), w, h)
+        sad = peak_bytes_per_pixel(MatcherParams(matcher="sad", block_size=SAD_WINDOW,
+                                                 num_disparities=nd, colour=False), w, h)
+        print(f"{w}x{h} / {nd}: own SGM {own:5.1f}  SGBM 3WAY {ref:5.1f}  ratio {own / ref:4.2f}"
+              f"   own SAD {sad:5.1f}   ({load()})", flush=True)
 
 
 def quality(mb: Path) -> None:
@@ -184,23 +231,62 @@ def subpixel(mb: Path) -> None:
                       f"bad1 {one.bad:6.2f}  rms {one.rms:5.3f}  bins {hi:5.1f} / {lo:4.1f}")
 
 
-def main() -> int:
+SECTIONS = {"sad": "own SAD / StereoBM at every size",
+            "sgm": "own SGM (5 paths) / SGBM 3WAY at every size",
+            "paths": "own SGM with 5, 8 and 4 paths / SGBM 3WAY at every size",
+            "memory": "peak memory per pixel of own SGM, SGBM 3WAY and own SAD",
+            "quality": "bad % on Cones and Teddy (needs STEREO_SERVO_DATA)",
+            "subpixel": "the sub-pixel fits on Cones and Teddy (needs STEREO_SERVO_DATA)"}
+DEFAULT = ("sad", "sgm", "memory", "quality", "subpixel")
+
+
+def parse(argv: list[str]) -> argparse.Namespace:
+    sizes = ", ".join(f"{w}x{h}/{nd}" for w, h, nd in SIZES)
+    ap = argparse.ArgumentParser(
+        prog="bench/matcher.py", formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Own matchers against OpenCV's, in alternating blocks in one process: "
+                    "the ratio own / OpenCV as CPU time on one thread and wall time on two, "
+                    f"at {sizes} (OpenCV takes a multiple of 16 candidates: 56 runs it at 64).",
+        epilog="sections:\n" + "\n".join(f"  {k:<9} {v}" for k, v in SECTIONS.items())
+               + f"\nwith none named: {' '.join(DEFAULT)}")
+    ap.add_argument("sections", nargs="*", metavar="SECTION",
+                    help="which to run (see below); default all but 'paths'")
+    ap.add_argument("--blocks", type=int, default=BLOCKS,
+                    help=f"alternating blocks per ratio, median taken (default {BLOCKS})")
+    args = ap.parse_args(argv)
+    unknown = [v for v in args.sections if v not in SECTIONS]
+    if unknown:
+        ap.error(f"unknown section {unknown[0]!r} (choose from {', '.join(SECTIONS)})")
+    if args.blocks < 1:
+        ap.error(f"--blocks must be at least 1, got {args.blocks}")
+    return args
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parse(sys.argv[1:] if argv is None else argv)
+    global BLOCKS
+    BLOCKS = args.blocks
+    only = set(args.sections) or set(DEFAULT)
     print(f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
-          f"cv2 {cv2.__version__}, numba {numba.__version__}, {BLOCKS} alternating blocks")
-    only = set(sys.argv[1:])
-    if not only or "sad" in only:
-        sad_vs_stereobm()
-    if not only or "sgm" in only:
-        sgm_vs_sgbm()
+          f"cv2 {cv2.__version__}, numba {numba.__version__}, {BLOCKS} alternating blocks, "
+          f"{load()}")
+    if "sad" in only:
+        speed("sad")
+    if "sgm" in only:
+        speed("sgm")
+    if "paths" in only:
+        speed("sgm", SGM_PATHS)
+    if "memory" in only:
+        memory()
     set_threads(2)
     data = os.environ.get("STEREO_SERVO_DATA")
     mb = Path(data) / "middlebury" if data else None
     if mb and (mb / "cones").is_dir():
-        if not only or "quality" in only:
+        if "quality" in only:
             quality(mb)
-        if not only or "subpixel" in only:
+        if "subpixel" in only:
             subpixel(mb)
-    else:
+    elif only & {"quality", "subpixel"}:
         print("\n(no STEREO_SERVO_DATA: Cones/Teddy figures skipped)")
     return 0
 

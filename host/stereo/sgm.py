@@ -18,6 +18,7 @@ import numpy as np
 from numba import njit, prange, types
 from numba.extending import intrinsic
 
+from host.stereo import lanes as L
 from host.stereo.subpixel import FIT_NONE, fit_offset
 
 CENSUS_H = 3  # half height of the census window (7 rows)
@@ -146,8 +147,37 @@ def _step(src, m, dst, c, p1, p2, nd):
     by PAD at each end; m = min L') and the cost c; returns min L.
     L[j] = C[j] + min(L'[j], L'[j-1] + P1, L'[j+1] + P1, min L' + P2) - min L'.
 
-    Every intermediate is cast back to uint16 so the loop runs in 16-bit lanes.
+    In 16-lane vectors (lanes.py) when nd >= 16: ceil(nd / 16) steps, the last one overlapping
+    the one before where nd is not a multiple of 16 (it writes the same values again, and the
+    minimum does not change). Below 16 candidates, a plain loop.
     """
+    if nd < L.LANES:
+        return _step_plain(src, m, dst, c, p1, p2, nd)
+    jump = L.splat(np.uint16(m + p2))
+    mv = L.splat(m)
+    p1v = L.splat(p1)
+    lo = L.splat(np.uint16(0xFFFF))
+    j = 0
+    while j < nd:
+        b = min(j, nd - L.LANES)
+        v = _lanes_step(src, b, c, mv, p1v, jump)
+        L.store(dst, b + 1, v)
+        lo = L.vmin(lo, v)
+        j += L.LANES
+    return L.hmin(lo)
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _lanes_step(src, b, c, mv, p1v, jump):
+    """Lanes b .. b + 16 of one path step (see _step) as a vector."""
+    near = L.vadd(L.vmin(L.load(src, b), L.load(src, b + 2)), p1v)
+    best = L.vmin(L.vmin(L.load(src, b + 1), near), jump)
+    return L.vsub(L.vadd(L.load(c, b), best), mv)
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _step_plain(src, m, dst, c, p1, p2, nd):
+    """_step in a plain loop (every intermediate cast back to uint16: 16-bit lanes)."""
     jump = np.uint16(m + p2)
     lo = np.uint16(0xFFFF)
     for j in range(nd):
@@ -161,11 +191,47 @@ def _step(src, m, dst, c, p1, p2, nd):
 @njit(cache=True, fastmath=True, inline="always")
 def _start(dst, c, nd):
     """A path's first pixel: L = C; returns min L."""
-    lo = np.uint16(0xFFFF)
-    for j in range(nd):
-        dst[j + 1] = c[j]
-        lo = min(lo, c[j])
-    return lo
+    if nd < L.LANES:
+        lo = np.uint16(0xFFFF)
+        for j in range(nd):
+            dst[j + 1] = c[j]
+            lo = min(lo, c[j])
+        return lo
+    lo = L.splat(np.uint16(0xFFFF))
+    j = 0
+    while j < nd:
+        b = min(j, nd - L.LANES)
+        v = L.load(c, b)
+        L.store(dst, b + 1, v)
+        lo = L.vmin(lo, v)
+        j += L.LANES
+    return L.hmin(lo)
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _sum_into(o, s, a1, a2, a3, a4, nd, with_min):
+    """o[j] = s[j] + a1[j+1] + a2[j+1] + a3[j+1] + a4[j+1] (s may be o itself: the overlapping
+    last vector keeps the lanes already summed); returns min o when with_min, else 0. A path
+    left out is passed as a row of zeros (nd + 2)."""
+    if nd < L.LANES:
+        lo = np.uint16(0xFFFF)
+        for j in range(nd):
+            v = np.uint16(s[j] + a1[j + 1] + a2[j + 1] + a3[j + 1] + a4[j + 1])
+            o[j] = v
+            lo = min(lo, v)
+        return lo if with_min else np.uint16(0)
+    lo = L.splat(np.uint16(0xFFFF))
+    j = 0
+    while j < nd:
+        b = min(j, nd - L.LANES)
+        old = L.load(s, b)
+        v = L.vadd(L.vadd(old, L.load(a1, b + 1)), L.vadd(L.load(a2, b + 1), L.vadd(
+            L.load(a3, b + 1), L.load(a4, b + 1))))
+        v = L.select_ge(j - b, v, L.load(o, b))
+        L.store(o, b, v)
+        lo = L.vmin(lo, v)
+        j += L.LANES
+    return L.hmin(lo) if with_min else np.uint16(0)
 
 
 @njit(cache=True, fastmath=True, inline="always")
@@ -255,7 +321,7 @@ def _sweep(cl, crrev, vol, S, P, M, crow, tot, forward, i0, i1, p1, p2, diagonal
     direction's paths: path 0 from behind in the row, 2 from the row before at the same x,
     and (diagonals) 1 and 3 from the row before at x - step and x + step.
 
-    P (2 row parities, 5 path slots, cols, nd + 2) and M (2, 5, cols) carry the path costs from
+    P (2 row parities, 4 path slots, cols, nd + 2) and M (2, 4, cols) carry the path costs from
     row to row, so one direction can stop at a row and go on from it in a later call. Without
     finish the row's path sum goes into S; with finish it is added to S's row (the other
     direction's sum) into tot and decided (and, with keep, stored back into S).
@@ -267,6 +333,7 @@ def _sweep(cl, crrev, vol, S, P, M, crow, tot, forward, i0, i1, p1, p2, diagonal
     jj = np.arange(nd + 1).astype(np.uint32)
     fb = np.empty((4, w), dtype=np.float32)
     mins = np.empty(w, dtype=np.uint16)
+    Z = np.zeros(nd + 2, dtype=np.uint16)
     for i in range(i0, i1):
         y = i if forward else h - 1 - i
         _cost_row(cl, crrev, vol, y, dmin, crow)
@@ -297,31 +364,13 @@ def _sweep(cl, crrev, vol, S, P, M, crow, tot, forward, i0, i1, p1, p2, diagonal
                 else:
                     M[b, 3, x] = _step(P[a, 3, x + step], M[a, 3, x + step], d3, c, p1, p2, nd)
                 if finish:
-                    o = tot[x]
-                    s = S[y, x]
-                    lo = np.uint16(0xFFFF)
-                    for j in range(nd):
-                        v = np.uint16(s[j] + h0[j + 1] + d1[j + 1] + v2[j + 1] + d3[j + 1])
-                        o[j] = v
-                        lo = min(lo, v)
-                    mins[x] = lo
+                    mins[x] = _sum_into(tot[x], S[y, x], h0, d1, v2, d3, nd, True)
                 else:
-                    o = S[y, x]
-                    for j in range(nd):
-                        o[j] = h0[j + 1] + d1[j + 1] + v2[j + 1] + d3[j + 1]
+                    _sum_into(S[y, x], Z, h0, d1, v2, d3, nd, False)
             elif finish:
-                o = tot[x]
-                s = S[y, x]
-                lo = np.uint16(0xFFFF)
-                for j in range(nd):
-                    v = np.uint16(s[j] + h0[j + 1] + v2[j + 1])
-                    o[j] = v
-                    lo = min(lo, v)
-                mins[x] = lo
+                mins[x] = _sum_into(tot[x], S[y, x], h0, v2, Z, Z, nd, True)
             else:
-                o = S[y, x]
-                for j in range(nd):
-                    o[j] = h0[j + 1] + v2[j + 1]
+                _sum_into(S[y, x], Z, h0, v2, Z, Z, nd, False)
         if finish:
             _decide_row(tot, mins, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc,
                         acc16, sh, idx, jj, fb)
@@ -352,6 +401,7 @@ def _down(cl, crrev, vol, S, P, M, crow, tot, y0, y1, warm, p1, p2, dmin, unique
     jj = np.arange(nd + 1).astype(np.uint32)
     fb = np.empty((4, w), dtype=np.float32)
     mins = np.empty(w, dtype=np.uint16)
+    Z = np.zeros(nd + 2, dtype=np.uint16)
     H = np.empty((2, nd + 2), dtype=np.uint16)
     H[:, 0] = PAD
     H[:, nd + 1] = PAD
@@ -383,9 +433,7 @@ def _down(cl, crrev, vol, S, P, M, crow, tot, y0, y1, warm, p1, p2, dmin, unique
                 continue
             h0 = H[x % 2]
             m0 = _start(h0, c, nd) if x == 0 else _step(H[1 - x % 2], m0, h0, c, p1, p2, nd)
-            o = tot[x]
-            for j in range(nd):
-                o[j] = h0[j + 1] + d1[j + 1] + v2[j + 1] + d3[j + 1]
+            _sum_into(tot[x], Z, h0, d1, v2, d3, nd, False)
         if not decided:
             continue
         m4 = np.uint16(0)
@@ -394,17 +442,27 @@ def _down(cl, crrev, vol, S, P, M, crow, tot, y0, y1, warm, p1, p2, dmin, unique
             c = crow[x]
             h4 = H[t % 2]
             m4 = _start(h4, c, nd) if t == 0 else _step(H[1 - t % 2], m4, h4, c, p1, p2, nd)
-            o = tot[x]
-            lo = np.uint16(0xFFFF)
-            for j in range(nd):
-                v = np.uint16(o[j] + h4[j + 1])
-                o[j] = v
-                lo = min(lo, v)
-            mins[x] = lo
+            mins[x] = _sum_into(tot[x], tot[x], h4, Z, Z, Z, nd, True)
         _decide_row(tot, mins, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc,
                     acc16, sh, idx, jj, fb)
         if keep:
             S[y] = tot
+
+
+@njit(cache=True)
+def _buffers(n, w, nd):
+    """n sets of the state one direction or stripe carries: rows of path costs P (2 row
+    parities, 4 path slots, cols, nd + 2, PAD at both ends) and their minima M, a cost row, a
+    row of totals, and the right view's minima (uint32 and uint16 packings)."""
+    P = np.empty((n, 2, 4, w, nd + 2), dtype=np.uint16)
+    P[:, :, :, :, 0] = PAD
+    P[:, :, :, :, nd + 1] = PAD
+    M = np.zeros((n, 2, 4, w), dtype=np.uint16)
+    crow = np.empty((n, w, nd), dtype=np.uint16)
+    tot = np.empty((n, w, nd), dtype=np.uint16)
+    acc = np.empty((n, w + nd), dtype=np.uint32)
+    acc16 = np.empty((n, w + nd), dtype=np.uint16)
+    return P, M, crow, tot, acc, acc16
 
 
 @njit(cache=True, parallel=True)
@@ -427,14 +485,6 @@ def match(cl, crrev, vol, S, dmin, p1, p2, paths, uniqueness, fit, want_right, k
     """
     h, w = cl.shape
     nd = S.shape[2]
-    P = np.empty((2, 2, 5, w, nd + 2), dtype=np.uint16)
-    P[:, :, :, :, 0] = PAD
-    P[:, :, :, :, nd + 1] = PAD
-    M = np.zeros((2, 2, 5, w), dtype=np.uint16)
-    crow = np.empty((2, w, nd), dtype=np.uint16)
-    tot = np.empty((2, w, nd), dtype=np.uint16)
-    acc = np.empty((2, w + nd), dtype=np.uint32)
-    acc16 = np.empty((2, w + nd), dtype=np.uint16)
     # a path cost is at most the largest cost + P2, so every total is under paths times that:
     # if it fits with the candidate's bits below it, the right view's minimum runs in uint16
     bits = 0
@@ -447,11 +497,15 @@ def match(cl, crrev, vol, S, dmin, p1, p2, paths, uniqueness, fit, want_right, k
     upper = (h + 1) // 2
     if paths == 5:
         for k in prange(2):
+            # each stripe's rows of path costs are its own: on one thread the second stripe
+            # reuses the first one's memory, so the peak holds one set
+            P, M, crow, tot, acc, acc16 = _buffers(1, w, nd)
             y0, y1 = (0, upper) if k == 0 else (upper, h)
-            _down(cl, crrev, vol, S, P[k], M[k], crow[k], tot[k], y0, y1,
+            _down(cl, crrev, vol, S, P[0], M[0], crow[0], tot[0], y0, y1,
                   0 if k == 0 else min(OVERLAP, upper), p1, p2, dmin, uniqueness, fit,
-                  want_right, disp_l, disp_r, acc[k], acc16[k], sh, keep)
+                  want_right, disp_l, disp_r, acc[0], acc16[0], sh, keep)
         return disp_l, disp_r
+    P, M, crow, tot, acc, acc16 = _buffers(2, w, nd)  # the directions go on from row to row
     diagonals = paths == 8
     for phase in range(2):
         for k in prange(2):
