@@ -131,3 +131,35 @@ def test_params_file_feeds_eval(tmp_path: Path, capsys) -> None:
     assert out["matcher"]["block_size"] == 7
     path.write_text("[matcher]\nblock_size = 'x'\n")
     assert main(["eval", "--params", str(path)]) == 2
+
+
+def test_matcher_sgm_alone_gives_its_measured_defaults(middlebury: Path, capsys) -> None:
+    tsukuba = str(middlebury / "tsukuba")
+    assert main(["eval", tsukuba, "--json", "--matcher", "sgm"]) == 0
+    got = json.loads(capsys.readouterr().out)["matcher"]
+    assert got == MatcherParams.for_matcher("sgm").to_dict()
+    assert got["paths"] == 8 and got["block_size"] == 1 and got["fill"] is True
+    assert main(["eval", tsukuba, "--json", "--matcher", "sgm", "--paths", "4", "--lr-check",
+                 "off", "--no-fill", "--median", "0"]) == 0
+    got = json.loads(capsys.readouterr().out)["matcher"]
+    assert got["paths"] == 4 and "lr_check" not in got and got["fill"] is False
+    assert got["median"] == 0
+    r = run("eval", tsukuba, "--matcher", "sgm", "--paths", "6")
+    assert r.returncode == 2 and "--paths" in r.stderr
+
+
+def test_params_file_without_a_range_keeps_the_scenes_range_policy(middlebury: Path,
+                                                                    tmp_path: Path,
+                                                                    capsys) -> None:
+    cones = str(middlebury / "cones")
+    path = tmp_path / "p.toml"
+    path.write_text('[matcher]\nmatcher = "sad"\nblock_size = 7\nborder = "clip"\n')
+    assert main(["eval", cones, "--json", "--params", str(path)]) == 0
+    from_file = json.loads(capsys.readouterr().out)["scenes"][0]["bad"]
+    assert main(["eval", cones, "--json", "--window", "7", "--border", "clip"]) == 0
+    scene_policy = json.loads(capsys.readouterr().out)["scenes"][0]["bad"]
+    assert from_file == scene_policy
+    # a file that fixes the range keeps it: 16 disparities are far too few for Cones
+    path.write_text(path.read_text() + "num_disparities = 16\n")
+    assert main(["eval", cones, "--json", "--params", str(path)]) == 0
+    assert json.loads(capsys.readouterr().out)["scenes"][0]["bad"] > scene_policy + 20

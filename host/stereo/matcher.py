@@ -13,6 +13,7 @@ import numpy as np
 from host.errors import HostError
 from host.stereo import block_matching as bm
 from host.stereo import sad, sgm
+from host.stereo.cost import census_ad_volume
 from host.stereo.grey import to_grey
 from host.stereo.opencv_backend import opencv_disparity
 from host.stereo.params import MatcherParams
@@ -135,15 +136,23 @@ NO_VOLUME = np.empty((0, 0, 0), dtype=np.uint16)
 
 
 def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.ndarray:
-    """The own census + semi-global matcher (host/stereo/sgm.py) on grey."""
+    """The own census + semi-global matcher (host/stereo/sgm.py) on grey. The cost comes from
+    the census rows inside the aggregation when it is census alone (window 1), else from a
+    cost volume (host/stereo/cost.py: the intensity term, the outside cost; the box sum)."""
     gl, gr = to_grey(left), to_grey(right)
     cl, cr = [sgm.census(cv2.copyMakeBorder(g, sgm.CENSUS_H, sgm.CENSUS_H, sgm.CENSUS_W,
                                             sgm.CENSUS_W, cv2.BORDER_REPLICATE))
               for g in (gl, gr)]
     vol = NO_VOLUME
-    if p.block_size > 1:
+    if p.intensity_weight > 0 or p.outside_cost != sgm.CENSUS_BITS:
         vol = np.empty((*gl.shape, p.num_disparities), dtype=np.uint16)
-        vol = sgm.box_sum(sgm.hamming_volume(cl, cr, p.min_disparity, vol), p.block_size)
+        vol = census_ad_volume(cl, cr, gl, gr, p.min_disparity, float(p.intensity_weight),
+                               p.intensity_cap, p.outside_cost, vol)
+    elif p.block_size > 1:
+        vol = np.empty((*gl.shape, p.num_disparities), dtype=np.uint16)
+        vol = sgm.hamming_volume(cl, cr, p.min_disparity, vol)
+    if p.block_size > 1:
+        vol = sgm.box_sum(vol, p.block_size)
     p1, p2 = sgm_penalties(p)
     want_right = p.lr_check is not None
     # the 5-path pass decides each row as it goes: no sum volume
