@@ -138,11 +138,11 @@ def test_matcher_sgm_alone_gives_its_measured_defaults(middlebury: Path, capsys)
     assert main(["eval", tsukuba, "--json", "--matcher", "sgm"]) == 0
     got = json.loads(capsys.readouterr().out)["matcher"]
     assert got == MatcherParams.for_matcher("sgm").to_dict()
-    assert got["paths"] == 8 and got["block_size"] == 1 and got["fill"] is True
-    assert main(["eval", tsukuba, "--json", "--matcher", "sgm", "--paths", "4", "--lr-check",
+    assert got["paths"] == 4 and got["block_size"] == 1 and got["fill"] is True
+    assert main(["eval", tsukuba, "--json", "--matcher", "sgm", "--paths", "8", "--lr-check",
                  "off", "--no-fill", "--median", "0"]) == 0
     got = json.loads(capsys.readouterr().out)["matcher"]
-    assert got["paths"] == 4 and "lr_check" not in got and got["fill"] is False
+    assert got["paths"] == 8 and "lr_check" not in got and got["fill"] is False
     assert got["median"] == 0
     r = run("eval", tsukuba, "--matcher", "sgm", "--paths", "6")
     assert r.returncode == 2 and "--paths" in r.stderr

@@ -72,7 +72,8 @@ def add_matcher_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--params", metavar="FILE", help="tuned parameters file (host tune --out)")
     g.add_argument("--matcher", choices=MATCHERS,
                    help="matching cost, or an OpenCV matcher; each starts from its measured "
-                        "best settings (sgm: window 1, clip, LR 1, fill, 8 paths, median 5)")
+                        "best settings (sgm: window 1, clip, LR 0, uniqueness 30, fill, 4 paths, "
+                        "median 5, whole pixels)")
     g.add_argument("--window", type=int_range(1), metavar="N", help="block size, odd (px)")
     g.add_argument("--num-disp", type=COUNT, metavar="N",
                    help="number of disparities (default: from the scene's ground truth, else 64)")

@@ -8,8 +8,9 @@ x - dmin - j.
   gain or gamma between the cameras changes nothing; it is weak on flat, untextured surfaces,
   where every neighbour is about as bright as the centre and noise decides the bits.
 - The intensity term, weight * min(|I_left(x) - I_right(x - d)|, cap), tells apart candidates
-  there (AD-census, Mei et al. 2011). Under a gain between the cameras the difference is large
-  for every candidate alike, so the cap turns it into a constant and census decides again.
+  there (AD-census, Mei et al. 2011). It would lose census's indifference to a gain or gamma
+  between the cameras, so the caller first maps the right image through match_histogram onto
+  the left one's grey levels (a global monotonic change is undone).
 - A candidate whose right pixel lies outside the image (the strip x < d of the left view, which
   the right camera does not see) costs `outside`: near a good match's cost rather than the
   census maximum, so the paths carry the disparity of the visible side into the strip instead
@@ -56,3 +57,20 @@ def census_ad_volume(cl, cr, gl, gr, dmin, weight, cap, outside, out):
             for j in range(n, nd):
                 o[j] = fout
     return out
+
+
+def match_histogram(img: np.ndarray, ref: np.ndarray, img_sample: np.ndarray | None = None,
+                    ref_sample: np.ndarray | None = None) -> np.ndarray:
+    """img (uint8) mapped through the monotonic table that gives it ref's grey-level histogram
+    (each level goes to the first level of ref whose cumulative share reaches its own).
+
+    A global gain, offset or gamma between the cameras is such a monotonic change, so the
+    intensity term compares the right image with the left one as if the sensors were alike;
+    between alike sensors the table is close to the identity.
+    """
+    a = img if img_sample is None else img_sample
+    b = ref if ref_sample is None else ref_sample
+    ch = np.cumsum(np.bincount(a.ravel(), minlength=256)) / a.size
+    cr = np.cumsum(np.bincount(b.ravel(), minlength=256)) / b.size
+    table = np.searchsorted(cr, ch - 1e-9).clip(0, 255).astype(np.uint8)
+    return table[img]

@@ -13,7 +13,7 @@ import numpy as np
 from host.errors import HostError
 from host.stereo import block_matching as bm
 from host.stereo import sad, sgm
-from host.stereo.cost import census_ad_volume
+from host.stereo.cost import census_ad_volume, match_histogram
 from host.stereo.grey import to_grey
 from host.stereo.opencv_backend import opencv_disparity
 from host.stereo.params import MatcherParams
@@ -146,7 +146,11 @@ def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
     vol = NO_VOLUME
     if p.intensity_weight > 0 or p.outside_cost != sgm.CENSUS_BITS:
         vol = np.empty((*gl.shape, p.num_disparities), dtype=np.uint16)
-        vol = census_ad_volume(cl, cr, gl, gr, p.min_disparity, float(p.intensity_weight),
+        # the intensity term sees the right image with the left one's grey levels, the table
+        # taken from the columns both cameras see (not the strip beside each image's edge)
+        cut = min(p.min_disparity + p.num_disparities, gl.shape[1] // 2)
+        er = match_histogram(gr, gl, gr[:, :gr.shape[1] - cut], gl[:, cut:])
+        vol = census_ad_volume(cl, cr, gl, er, p.min_disparity, float(p.intensity_weight),
                                p.intensity_cap, p.outside_cost, vol)
     elif p.block_size > 1:
         vol = np.empty((*gl.shape, p.num_disparities), dtype=np.uint16)
