@@ -86,13 +86,15 @@ def add_matcher_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--border", choices=BORDERS, help="window at the image edge: invalid or clip")
     g.add_argument("--fill", action="store_true", default=None,
                    help="fill invalid pixels from the farther neighbour")
-    g.add_argument("--no-fill", dest="fill", action="store_false",
+    g.add_argument("--no-fill", dest="fill", action="store_false", default=None,
                    help="leave invalid pixels without a disparity")
     g.add_argument("--paths", type=int, choices=SGM_PATHS,
                    help="aggregation paths of the own SGM")
     g.add_argument("--median", type=int, choices=(0, 3, 5), help="median filter size")
+    g.add_argument("--subpixel", dest="subpixel", action="store_true", default=None,
+                   help="sub-pixel disparities (a fit through the costs beside the winner)")
     g.add_argument("--no-subpixel", dest="subpixel", action="store_false", default=None,
-                   help="whole-pixel disparities (no sub-pixel fit)")
+                   help="whole-pixel disparities (the own SGM's default)")
     g.add_argument("--grey", dest="colour", action="store_false", default=None,
                    help="match on grey even when the images have colour")
 

@@ -22,6 +22,8 @@ from host.stereo.subpixel import DEFAULT_FITS, FIT_NONE, FITS
 
 SGM_P1 = 8  # default SGM penalties per pixel of the cost box (census bits)
 SGM_P2 = 32
+SGM_MIXED_P1 = 18  # the same with the intensity term (MatcherParams.intensity_weight > 0)
+SGM_MIXED_P2 = 72
 # pixel-disparities (about 1.5 ms of SAD on one core) below which a match runs on the calling
 # thread alone: waking numba's thread pool costs more than it saves there, and on a loaded
 # machine a sleeping worker took 7-40 ms to join a 0.2 ms match of the servo's marker window
@@ -108,10 +110,13 @@ def sad_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
 
 
 def sgm_penalties(p: MatcherParams) -> tuple[int, int]:
-    """(P1, P2) for the own SGM: p.p1 / p.p2 when set, else defaults per box-summed census."""
+    """(P1, P2) for the own SGM: p.p1 / p.p2 when set, else the defaults per pixel of the cost
+    box: SGM_P1 / SGM_P2 for census alone, SGM_MIXED_P1 / SGM_MIXED_P2 with the intensity term
+    (its costs span more; measured on the ten shared scenes, docs/stereo.md)."""
     area = p.block_size ** 2
-    p1 = p.p1 or SGM_P1 * area
-    return p1, max(p.p2 or SGM_P2 * area, p1)
+    base1, base2 = (SGM_MIXED_P1, SGM_MIXED_P2) if p.intensity_weight > 0 else (SGM_P1, SGM_P2)
+    p1 = p.p1 or base1 * area
+    return p1, max(p.p2 or base2 * area, p1)
 
 
 _VOLUMES = threading.local()
@@ -166,7 +171,10 @@ def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
                                np.uint16(p1), np.uint16(p2), p.paths,
                                float(p.uniqueness_ratio), subpixel_fit(p), want_right, False)
     if want_right:
-        disp_l = lr_consistency(disp_l, disp_r, float(p.lr_check))
+        # the right map has whole pixels: with a sub-pixel left map a tolerance under half a
+        # pixel (LR 0, the default) means the same winner, not no sub-pixel result at all
+        tol = float(p.lr_check)
+        disp_l = lr_consistency(disp_l, disp_r, max(tol, 0.5) if subpixel_fit(p) else tol)
     if p.border == "invalid":
         # the census (and box) window of these pixels leaves the image
         ry, rx = sgm.CENSUS_H + p.block_size // 2, sgm.CENSUS_W + p.block_size // 2

@@ -17,7 +17,7 @@ CENSUS_BITS = 62  # bits of the own SGM's 9x7 census (host.stereo.sgm.CENSUS_BIT
 # the ten shared Middlebury scenes, leave-one-out (docs/stereo.md, "SGM defaults")
 MATCHER_DEFAULTS: dict[str, dict[str, Any]] = {
     "sgm": {"block_size": 1, "border": "clip", "lr_check": 0.0, "uniqueness_ratio": 30.0,
-            "fill": True, "median": 5, "paths": 4, "subpixel": False, "p1": 18, "p2": 72,
+            "fill": True, "median": 5, "paths": 4, "subpixel": False,
             "intensity_weight": 1.0, "intensity_cap": 20, "outside_cost": 20},
 }
 

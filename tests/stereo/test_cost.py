@@ -50,7 +50,8 @@ def test_census_alone_through_the_volume_equals_the_census_rows() -> None:
     # the same cost by the two routes (inside the aggregation, or a volume: a weight whose
     # term rounds to 0 at every capped difference) gives the same map
     scene = synthetic_scene(seed=4, noise=0.5)
-    plain = MatcherParams(matcher="sgm", block_size=1, num_disparities=48, border="clip")
+    plain = MatcherParams(matcher="sgm", block_size=1, num_disparities=48, border="clip", p1=8,
+                          p2=32)
     rows = compute_disparity(scene.left, scene.right, plain)
     vol = compute_disparity(scene.left, scene.right, plain.replace(intensity_weight=0.01))
     np.testing.assert_array_equal(rows, vol)

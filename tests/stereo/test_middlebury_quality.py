@@ -135,3 +135,12 @@ def test_sgm_defaults_keep_census_indifference_to_gain_and_gamma(middlebury: Pat
     clean, changed = bad(own, scene.right), bad(own, right)
     assert changed < clean + 1.2, (clean, changed)
     assert bad(STRONGEST_SGBM, right) > changed + 5
+
+
+def test_sgm_defaults_with_subpixel_keep_the_lr_check_meaningful(middlebury: Path) -> None:
+    # LR 0 compares whole pixels; a sub-pixel left map is compared by its winner (within half
+    # a pixel), not rejected wholesale (it was: 48.6 % bad on Cones, all of it filled)
+    whole = _scores(str(middlebury), "cones", MatcherParams.for_matcher("sgm"))
+    sub = _scores(str(middlebury), "cones", MatcherParams.for_matcher("sgm").replace(
+        subpixel=True))
+    assert sub[0] < whole[0] + 0.5, (whole, sub)
