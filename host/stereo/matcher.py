@@ -141,7 +141,8 @@ NO_VOLUME = np.empty((0, 0, 0), dtype=np.uint16)
 
 
 def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.ndarray:
-    """The own census + semi-global matcher (host/stereo/sgm.py) on grey. The cost comes from
+    """The own census + semi-global matcher (host/stereo/sgm.py): census of grey, the
+    intensity term on colour (p.colour) or grey. The cost comes from
     the census rows inside the aggregation when it is census alone (window 1), else from a
     cost volume (host/stereo/cost.py: the intensity term, the outside cost; the box sum)."""
     gl, gr = to_grey(left), to_grey(right)
@@ -150,12 +151,14 @@ def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
               for g in (gl, gr)]
     vol = NO_VOLUME
     if p.intensity_weight > 0 or p.outside_cost != sgm.CENSUS_BITS:
-        vol = np.empty((*gl.shape, p.num_disparities), dtype=np.uint16)
-        # the intensity term sees the right image with the left one's grey levels, the table
-        # taken from the columns both cameras see (not the strip beside each image's edge)
+        pl, pr = _planes(left, p.colour), _planes(right, p.colour)
+        # the intensity term sees the right image with the left one's levels (per channel),
+        # the table taken from the columns both cameras see (not the strip beside each edge)
         cut = min(p.min_disparity + p.num_disparities, gl.shape[1] // 2)
-        er = match_histogram(gr, gl, gr[:, :gr.shape[1] - cut], gl[:, cut:])
-        vol = census_ad_volume(cl, cr, gl, er, p.min_disparity, float(p.intensity_weight),
+        pr = np.stack([match_histogram(b, a, b[:, :b.shape[1] - cut], a[:, cut:])
+                       for a, b in zip(pl, pr)])
+        vol = np.empty((*gl.shape, p.num_disparities), dtype=np.uint16)
+        vol = census_ad_volume(cl, cr, pl, pr, p.min_disparity, float(p.intensity_weight),
                                p.intensity_cap, p.outside_cost, vol)
     elif p.block_size > 1:
         vol = np.empty((*gl.shape, p.num_disparities), dtype=np.uint16)
@@ -202,7 +205,8 @@ def compute_disparity(left: np.ndarray, right: np.ndarray, params: MatcherParams
 
 def matched_on(image: np.ndarray, p: MatcherParams) -> str:
     """"colour" when the matcher p names matches on image's BGR channels, else "grey"."""
-    colour = p.matcher in ("sad", "ssd", "opencv-sgbm") and p.colour
+    colour = p.colour and (p.matcher in ("sad", "ssd", "opencv-sgbm")
+                           or (p.matcher == "sgm" and p.intensity_weight > 0))
     return "colour" if colour and image.ndim == 3 and image.shape[2] >= 3 else "grey"
 
 

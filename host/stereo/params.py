@@ -18,7 +18,7 @@ CENSUS_BITS = 62  # bits of the own SGM's 9x7 census (host.stereo.sgm.CENSUS_BIT
 MATCHER_DEFAULTS: dict[str, dict[str, Any]] = {
     "sgm": {"block_size": 1, "border": "clip", "lr_check": 0.0, "uniqueness_ratio": 30.0,
             "fill": True, "median": 5, "paths": 4, "subpixel": False,
-            "intensity_weight": 1.0, "intensity_cap": 20, "outside_cost": 20},
+            "intensity_weight": 1.0, "intensity_cap": 20, "outside_cost": 23},
 }
 
 

@@ -27,7 +27,7 @@ def test_volume_is_hamming_plus_capped_intensity_and_outside_beyond_the_image(
     gr = rng.integers(0, 256, (7, 19), dtype=np.uint8)
     cl, cr = _census(gl), _census(gr)
     nd = 9
-    got = census_ad_volume(cl, cr, gl, gr, dmin, weight, cap, outside,
+    got = census_ad_volume(cl, cr, gl[None], gr[None], dmin, weight, cap, outside,
                            np.empty((7, 19, nd), np.uint16))
     for y in range(7):
         for x in range(19):
@@ -40,6 +40,18 @@ def test_volume_is_hamming_plus_capped_intensity_and_outside_beyond_the_image(
                     diff = min(abs(int(gl[y, x]) - int(gr[y, xr])), cap)
                     want = ham + int(np.floor(weight * diff + 0.5))
                 assert got[y, x, j] == want, (y, x, j)
+
+
+def test_colour_term_is_the_mean_of_the_channels_differences() -> None:
+    rng = np.random.default_rng(3)
+    pl = rng.integers(0, 256, (3, 5, 12), dtype=np.uint8)
+    pr = rng.integers(0, 256, (3, 5, 12), dtype=np.uint8)
+    none = np.zeros((5, 12), np.uint64)  # equal census: the volume is the intensity term
+    got = census_ad_volume(none, none, pl, pr, 0, 0.5, 30, 99, np.empty((5, 12, 4), np.uint16))
+    for y, x, j in [(0, 3, 0), (2, 7, 3), (4, 11, 2), (1, 5, 3)]:
+        diff = np.abs(pl[:, y, x].astype(int) - pr[:, y, x - j].astype(int)).mean()
+        assert got[y, x, j] == int(np.floor(0.5 * min(diff, 30) + 0.5))
+    assert got[0, 2, 3] == 99
 
 
 def test_census_bits_constant_agrees_with_the_matcher() -> None:

@@ -74,17 +74,16 @@ def test_sgm_defaults_beat_the_strongest_sgbm_by_1_5_points_on_the_ten(middlebur
     own = np.mean([_scores(str(middlebury), n, MatcherParams.for_matcher("sgm")) for n in names],
                   axis=0)
     ocv = np.mean([_scores(str(middlebury), n, STRONGEST_SGBM) for n in names], axis=0)
-    # measured: own 3.11 / 7.60, SGBM 6.02 / 12.28
+    # measured: own 2.93 / 7.43, SGBM 6.02 / 12.28
     assert own[0] <= ocv[0] - 1.5 and own[1] <= ocv[1] - 1.5, (own, ocv)
 
 
-def test_sgm_defaults_against_semiglob_on_the_classic_scenes(middlebury: Path) -> None:
+def test_sgm_defaults_at_or_below_semiglob_on_the_classic_scenes(middlebury: Path) -> None:
+    # measured: Tsukuba 2.59 / 3.74, Venus 0.78 / 1.574, Teddy 4.96 / 11.02, Cones 3.01 / 8.79;
+    # the table gives two decimals, so Venus's all is at SemiGlob's 1.57 to its precision
     got = {n: _scores(str(middlebury), n, MatcherParams.for_matcher("sgm")) for n in SEMIGLOB}
-    for name in ("tsukuba", "teddy", "cones"):  # at or below SemiGlob's nonocc and all
-        assert got[name][0] <= SEMIGLOB[name][0] and got[name][1] <= SEMIGLOB[name][1], got
-    # not yet there on Venus's all (measured 0.88 / 1.65): within 0.1 pt
-    assert got["venus"][0] <= SEMIGLOB["venus"][0], got
-    assert got["venus"][1] <= SEMIGLOB["venus"][1] + 0.1, got
+    for name, (nonocc, whole) in SEMIGLOB.items():
+        assert got[name][0] <= nonocc and got[name][1] < whole + 0.01, (name, got[name])
 
 
 @pytest.mark.parametrize("name", ["aloe", "art", "cones", "dolls", "teddy"])
@@ -119,8 +118,8 @@ def test_sgm_defaults_keep_census_indifference_to_gain_and_gamma(middlebury: Pat
                                                                  change: str) -> None:
     # a right camera with gain 0.7 or gamma 1.5: the intensity term sees the right image
     # through the histogram table, so the map stays near the clean one (measured on Cones,
-    # nonocc: 2.89 clean, 2.88 gain, 3.84 gamma; without the table 7.2 / 7.3), while the
-    # strongest SGBM, which compares intensities, falls apart
+    # nonocc: 3.01 clean, 3.11 gain, 3.07 gamma; grey without the table 3.22 clean, 7.2 / 7.3),
+    # while the strongest SGBM, which compares intensities, falls apart
     scene = load_scene(middlebury / "cones")
     right = scene.right.astype(np.float32)
     right = (right * 0.7 if change == "gain" else 255 * (right / 255) ** 1.5).astype(np.uint8)
@@ -133,7 +132,7 @@ def test_sgm_defaults_keep_census_indifference_to_gain_and_gamma(middlebury: Pat
 
     own = MatcherParams.for_matcher("sgm")
     clean, changed = bad(own, scene.right), bad(own, right)
-    assert changed < clean + 1.2, (clean, changed)
+    assert changed < clean + 0.5, (clean, changed)
     assert bad(STRONGEST_SGBM, right) > changed + 5
 
 
