@@ -33,24 +33,22 @@ DEFAULT = MatcherParams.for_matcher("sgm")
 OLD_DEFAULT = MatcherParams(matcher="sgm")  # what `--matcher sgm` gave before (window 9 ...)
 FORMER_BEST = MatcherParams(matcher="sgm", block_size=1, border="clip", lr_check=1.0,
                             fill=True)
-CENSUS_ONLY = {"intensity_weight": 0.0}
+CENSUS_ONLY = {"intensity_weight": 0.0, "outside_cost": 11}  # census alone, its own outside cost
 
+_8 = FORMER_BEST.replace(paths=8, median=5, subpixel=False)
+_MIXED = _8.replace(outside_cost=23, intensity_weight=1.0, p1=8, p2=32)
 STEPS = [
     ("former documented best (window 1, clip, LR 1, fill, 5 paths)", FORMER_BEST),
-    ("+ 8 paths, median 5, whole pixels", FORMER_BEST.replace(paths=8, median=5,
-                                                              subpixel=False)),
-    ("+ outside cost 11 (census alone)", FORMER_BEST.replace(paths=8, median=5, subpixel=False,
-                                                             outside_cost=11)),
-    ("+ intensity term (weight 1, cap 20), outside 20",
-     FORMER_BEST.replace(paths=8, median=5, subpixel=False, outside_cost=20,
-                         intensity_weight=1.0)),
-    ("+ LR 0, uniqueness 30", FORMER_BEST.replace(paths=8, median=5, subpixel=False,
-                                                   outside_cost=20, intensity_weight=1.0,
-                                                   lr_check=0.0, uniqueness_ratio=30)),
+    ("+ 8 paths, median 5, whole pixels", _8),
+    ("+ outside cost 11 (census alone)", _8.replace(outside_cost=11)),
+    ("+ intensity term on grey (weight 1, cap 20), outside 23", _MIXED.replace(colour=False)),
+    ("+ the intensity term on colour", _MIXED),
+    ("+ LR 0, uniqueness 30", _MIXED.replace(lr_check=0.0, uniqueness_ratio=30)),
     ("+ P1 18 / P2 72, 4 paths = the defaults", DEFAULT),
 ]
 WITHOUT = [
-    ("defaults without the intensity term", DEFAULT.replace(**CENSUS_ONLY)),
+    ("defaults with census alone (outside cost 11, P1 8 / P2 32)", DEFAULT.replace(**CENSUS_ONLY)),
+    ("defaults with the intensity term on grey (--grey)", DEFAULT.replace(colour=False)),
     ("defaults with the census maximum outside", DEFAULT.replace(outside_cost=CENSUS_BITS)),
     ("defaults with LR 1", DEFAULT.replace(lr_check=1.0)),
     ("defaults without uniqueness", DEFAULT.replace(uniqueness_ratio=0.0)),
@@ -119,7 +117,7 @@ def main(argv: list[str] | None = None) -> int:
         extra += [("right gain 0.7", gain), ("right gamma 1.5", gamma)]
     for what, change in extra:
         row(f"defaults, {what}", scores(scenes, DEFAULT, change))
-        row(f"defaults without the intensity term, {what}",
+        row(f"defaults with census alone, {what}",
             scores(scenes, DEFAULT.replace(**CENSUS_ONLY), change))
         row(f"strongest SGBM, {what}", scores(scenes, STRONGEST_SGBM, change))
     return 0
