@@ -61,7 +61,12 @@ SEED = int_range(0)  # >= 0
 
 def _tolerance_or_off(text: str) -> float:
     """--lr-check's type: a tolerance in px (>= 0), or "off"."""
-    return -1.0 if text == "off" else NON_NEGATIVE(text)
+    if text == "off":
+        return -1.0
+    try:
+        return NON_NEGATIVE(text)
+    except argparse.ArgumentTypeError as e:
+        raise argparse.ArgumentTypeError(f"{e} (or off)") from None
 
 
 _tolerance_or_off.__name__ = "float"
