@@ -89,3 +89,12 @@ def load_disparity_range(path: str | os.PathLike[str]) -> dict[str, Any] | None:
         return tomllib.loads(Path(path).read_text()).get("disparity_range")
     except (OSError, tomllib.TOMLDecodeError):
         return None  # load_params reports the problem
+
+
+def load_matcher_table(path: str | os.PathLike[str]) -> dict[str, Any]:
+    """The raw [matcher] table of a params file (empty when unreadable: load_params reports)."""
+    try:
+        table = tomllib.loads(Path(path).read_text()).get("matcher", {})
+    except (OSError, tomllib.TOMLDecodeError, UnicodeDecodeError, ValueError, RecursionError):
+        return {}
+    return table if isinstance(table, dict) else {}

@@ -12,6 +12,8 @@ import numpy as np
 import pytest
 
 from host.cli import main
+from host.stereo import MatcherParams, compute_disparity, evaluate, load_scene
+from host.stereo.metrics import round_submission
 from host.stereo.synthetic import synthetic_scene
 
 
@@ -42,18 +44,44 @@ def test_eval_json_has_the_documented_keys(middlebury: Path, capsys) -> None:
     assert main(["eval", str(middlebury / "cones"), "--json", "--border", "clip"]) == 0
     out = json.loads(capsys.readouterr().out)
     row = out["scenes"][0]
-    assert set(row) == {"scene", "bad", "bad_nonocc", "rms", "density", "ms"}
+    assert set(row) == {"scene", "bad", "bad_nonocc", "bad_disc", "rms", "density", "ms"}
     assert row["scene"] == "cones" and 0 < row["bad_nonocc"] < row["bad"] < 100
+    assert 0 < row["bad_disc"] < 100
+
+
+def test_eval_scores_middlebury_regions_by_their_masks(middlebury: Path, capsys) -> None:
+    # Venus has all.png: its "all" region is not every pixel with known ground truth
+    scene = load_scene(middlebury / "venus")
+    argv = ["eval", str(middlebury / "venus"), "--json", "--matcher", "sad", "--window", "7",
+            "--border", "clip"]
+    assert main(argv) == 0
+    row = json.loads(capsys.readouterr().out)["scenes"][0]
+    p = MatcherParams(matcher="sad", block_size=7, border="clip",
+                      num_disparities=scene.num_disparities(1))
+    disp = compute_disparity(scene.left, scene.right, p)
+    by_mask = {k: evaluate(disp, scene.gt, scene.masks[k]).bad for k in ("nonocc", "all", "disc")}
+    assert row["bad"] == pytest.approx(by_mask["all"], abs=1e-9)
+    assert row["bad_nonocc"] == pytest.approx(by_mask["nonocc"], abs=1e-9)
+    assert row["bad_disc"] == pytest.approx(by_mask["disc"], abs=1e-9)
+    assert abs(by_mask["all"] - evaluate(disp, scene.gt).bad) > 0.3  # the mask matters here
+    assert by_mask["disc"] > by_mask["all"] > by_mask["nonocc"]
+    assert main([*argv, "--round8"]) == 0
+    rounded = json.loads(capsys.readouterr().out)["scenes"][0]
+    assert rounded["bad"] == pytest.approx(
+        evaluate(round_submission(disp, 8.0), scene.gt, scene.masks["all"]).bad, abs=1e-9)
+    assert rounded["bad"] != row["bad"]
 
 
 def test_eval_default_scene_prints_a_table_with_null_nonocc(capsys) -> None:
     assert main(["eval", "--json"]) == 0
     row = json.loads(capsys.readouterr().out)["scenes"][0]
-    assert row["scene"] == "motorcycle" and row["bad_nonocc"] is None
+    assert row["scene"] == "motorcycle" and row["bad_nonocc"] is None and row["bad_disc"] is None
     assert main(["eval", "--window", "11"]) == 0
     lines = capsys.readouterr().out.splitlines()
-    assert lines[1].split() == ["scene", "bad%", "nonocc%", "rms", "density%", "ms"]
-    assert lines[2].split()[0] == "motorcycle" and lines[2].split()[2] == "-"
+    assert lines[1].split() == ["scene", "bad%", "nonocc%", "disc%", "rms", "density%", "ms"]
+    assert lines[2].split()[0] == "motorcycle" and lines[2].split()[2:4] == ["-", "-"]
+    assert main(["eval", "--round8"]) == 2  # a float (PFM) ground truth has no 8-bit scale
+    assert "no 8-bit ground-truth scale" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("argv, message", [
@@ -103,3 +131,35 @@ def test_params_file_feeds_eval(tmp_path: Path, capsys) -> None:
     assert out["matcher"]["block_size"] == 7
     path.write_text("[matcher]\nblock_size = 'x'\n")
     assert main(["eval", "--params", str(path)]) == 2
+
+
+def test_matcher_sgm_alone_gives_its_measured_defaults(middlebury: Path, capsys) -> None:
+    tsukuba = str(middlebury / "tsukuba")
+    assert main(["eval", tsukuba, "--json", "--matcher", "sgm"]) == 0
+    got = json.loads(capsys.readouterr().out)["matcher"]
+    assert got == MatcherParams.for_matcher("sgm").to_dict()
+    assert got["paths"] == 4 and got["block_size"] == 1 and got["fill"] is True
+    assert main(["eval", tsukuba, "--json", "--matcher", "sgm", "--paths", "8", "--lr-check",
+                 "off", "--no-fill", "--median", "0"]) == 0
+    got = json.loads(capsys.readouterr().out)["matcher"]
+    assert got["paths"] == 8 and "lr_check" not in got and got["fill"] is False
+    assert got["median"] == 0
+    r = run("eval", tsukuba, "--matcher", "sgm", "--paths", "6")
+    assert r.returncode == 2 and "--paths" in r.stderr
+
+
+def test_params_file_without_a_range_keeps_the_scenes_range_policy(middlebury: Path,
+                                                                    tmp_path: Path,
+                                                                    capsys) -> None:
+    cones = str(middlebury / "cones")
+    path = tmp_path / "p.toml"
+    path.write_text('[matcher]\nmatcher = "sad"\nblock_size = 7\nborder = "clip"\n')
+    assert main(["eval", cones, "--json", "--params", str(path)]) == 0
+    from_file = json.loads(capsys.readouterr().out)["scenes"][0]["bad"]
+    assert main(["eval", cones, "--json", "--window", "7", "--border", "clip"]) == 0
+    scene_policy = json.loads(capsys.readouterr().out)["scenes"][0]["bad"]
+    assert from_file == scene_policy
+    # a file that fixes the range keeps it: 16 disparities are far too few for Cones
+    path.write_text(path.read_text() + "num_disparities = 16\n")
+    assert main(["eval", cones, "--json", "--params", str(path)]) == 0
+    assert json.loads(capsys.readouterr().out)["scenes"][0]["bad"] > scene_policy + 20

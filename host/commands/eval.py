@@ -29,7 +29,7 @@ from host.files import (
     write_image_atomic,
 )
 from host.stereo.matcher import compute_disparity, matched_on, warm_up
-from host.stereo.metrics import evaluate
+from host.stereo.metrics import middlebury, round_submission
 from host.stereo.params import MatcherParams
 from host.stereo.picture import picture
 from host.stereo.scenes import Scene, load_scenes
@@ -42,6 +42,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                         "pair)")
     p.add_argument("--scale", type=POSITIVE, help="ground-truth scale for 2001/2003 layouts")
     p.add_argument("--rho", type=POSITIVE, default=1.0, help="bad-pixel threshold (px)")
+    p.add_argument("--round8", action="store_true",
+                   help="score each map as an 8-bit Middlebury v2 submission stores it: "
+                        "round(d * scale) / scale with the scene's ground-truth scale")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--picture", type=Path, metavar="DIR",
                    help="write each scene's disparity picture into DIR")
@@ -49,19 +52,29 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(run=run)
 
 
-def score_scene(scene: Scene, params: MatcherParams, rho: float) -> dict[str, Any]:
-    """One row of the table: bad (all GT-known), bad_nonocc, rms, density (%), ms (one
-    compute_disparity call after warm-up)."""
+def score_scene(scene: Scene, params: MatcherParams, rho: float, round8: bool = False
+                ) -> dict[str, Any]:
+    """One row of the table, Middlebury v2's regions: bad (all: all.png where the scene has
+    it, else every pixel with known ground truth), bad_nonocc, bad_disc (None where the
+    scene has no such mask), rms and density (%) over all, ms (one compute_disparity call
+    after warm-up). round8: the map is rounded as an 8-bit submission first."""
     warm_up(params)
     t0 = time.perf_counter()
     disp = compute_disparity(scene.left, scene.right, params)
     ms = (time.perf_counter() - t0) * 1000
     assert scene.gt is not None
-    whole = evaluate(disp, scene.gt, rho=rho)
-    nonocc = scene.masks.get("nonocc")
-    bad_nonocc = evaluate(disp, scene.gt, nonocc, rho).bad if nonocc is not None else None
-    return {"scene": scene.name, "bad": whole.bad, "bad_nonocc": bad_nonocc, "rms": whole.rms,
-            "density": whole.density, "ms": ms, "disp": disp}
+    if round8:
+        assert scene.scale is not None
+        disp = round_submission(disp, scene.scale)
+    scores = middlebury(disp, scene.gt, scene.masks, rho)
+    whole = scores["all"]
+
+    def bad(region: str) -> float | None:
+        return scores[region].bad if region in scores else None
+
+    return {"scene": scene.name, "bad": whole.bad, "bad_nonocc": bad("nonocc"),
+            "bad_disc": bad("disc"), "rms": whole.rms, "density": whole.density, "ms": ms,
+            "disp": disp}
 
 
 def _scene_range(args: argparse.Namespace, params: MatcherParams, scene: Scene
@@ -90,6 +103,8 @@ def run(args: argparse.Namespace) -> int:
     for scene in scenes:
         if scene.gt is None:
             raise HostError(f"{scene.name}: no ground truth to evaluate against")
+        if args.round8 and scene.scale is None:
+            raise HostError(f"{scene.name}: no 8-bit ground-truth scale to round to (--round8)")
     with all_or_nothing():  # the pictures appear together, after every scene was scored
         rows = [_score(scene, params, args) for scene in scenes]
     out = [{k: (None if isinstance(v, float) and math.isnan(v) else v)
@@ -98,10 +113,15 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps({"matcher": params.to_dict(), "scenes": out}))
         return 0
     print(f"matcher {params.matcher}, window {params.block_size}, rho {args.rho} px")
-    print(f"{'scene':<16}{'bad%':>8}{'nonocc%':>9}{'rms':>8}{'density%':>10}{'ms':>9}")
+    print(f"{'scene':<16}{'bad%':>8}{'nonocc%':>9}{'disc%':>8}{'rms':>8}{'density%':>10}"
+          f"{'ms':>9}")
     for r in out:
         print(f"{r['scene']:<16}{_fmt(r['bad']):>8}{_fmt(r['bad_nonocc']):>9}"
-              f"{_fmt(r['rms']):>8}{_fmt(r['density']):>10}{_fmt(r['ms'], '.1f'):>9}")
+              f"{_fmt(r['bad_disc']):>8}{_fmt(r['rms']):>8}{_fmt(r['density']):>10}"
+              f"{_fmt(r['ms'], '.1f'):>9}")
+    rounded = ", maps rounded as 8-bit submissions" if args.round8 else ""
+    print("bad%: Middlebury v2's 'all' region (all.png where the scene has it, else every pixel "
+          f"with known ground truth){rounded}")
     inputs = sorted({matched_on(s.left, params) for s in scenes})
     print(f"ms: one compute_disparity call on the {'/'.join(inputs)} pair after warm-up, "
           f"{numba.get_num_threads()} numba / {cv2.getNumThreads()} OpenCV threads")
@@ -111,7 +131,7 @@ def run(args: argparse.Namespace) -> int:
 def _score(scene: Scene, params: MatcherParams, args: argparse.Namespace) -> dict[str, Any]:
     """Score one scene; with --picture, stage its picture (named from the scene, made safe)."""
     p = params if num_disp_given(args) else _scene_range(args, params, scene)
-    row = score_scene(scene, p, args.rho)
+    row = score_scene(scene, p, args.rho, args.round8)
     if args.picture:
         path = check_output(inside(args.picture, safe_name(scene.name, ".png")), IMAGE,
                             "--picture")

@@ -8,8 +8,8 @@ import argparse
 import math
 from collections.abc import Callable
 
-from host.params_file import load_disparity_range, load_params
-from host.stereo.params import BORDERS, MATCHERS, MatcherParams
+from host.params_file import load_disparity_range, load_matcher_table, load_params
+from host.stereo.params import BORDERS, MATCHERS, SGM_PATHS, MatcherParams
 
 
 def _bounds(lo: float | None, hi: float | None, lo_open: bool, hi_open: bool) -> str:
@@ -59,24 +59,47 @@ COUNT = int_range(1)  # >= 1
 SEED = int_range(0)  # >= 0
 
 
+def _tolerance_or_off(text: str) -> float:
+    """--lr-check's type: a tolerance in px (>= 0), or "off"."""
+    if text == "off":
+        return -1.0
+    try:
+        return NON_NEGATIVE(text)
+    except argparse.ArgumentTypeError as e:
+        raise argparse.ArgumentTypeError(f"{e} (or off)") from None
+
+
+_tolerance_or_off.__name__ = "float"
+
+
 def add_matcher_options(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("matcher (defaults: --params file, else the built-in defaults)")
     g.add_argument("--params", metavar="FILE", help="tuned parameters file (host tune --out)")
-    g.add_argument("--matcher", choices=MATCHERS, help="matching cost, or an OpenCV matcher")
+    g.add_argument("--matcher", choices=MATCHERS,
+                   help="matching cost, or an OpenCV matcher; each starts from its measured "
+                        "best settings (sgm: window 1, clip, LR 0, uniqueness 30, fill, 4 paths, "
+                        "median 5, whole pixels)")
     g.add_argument("--window", type=int_range(1), metavar="N", help="block size, odd (px)")
     g.add_argument("--num-disp", type=COUNT, metavar="N",
                    help="number of disparities (default: from the scene's ground truth, else 64)")
     g.add_argument("--min-disp", type=int, metavar="N", help="smallest disparity (px)")
-    g.add_argument("--lr-check", type=NON_NEGATIVE, metavar="PX",
-                   help="left-right consistency tolerance (px); off when not given")
+    g.add_argument("--lr-check", type=_tolerance_or_off, metavar="PX",
+                   help="left-right consistency tolerance (px), or off (the matcher's default "
+                        "when not given)")
     g.add_argument("--uniqueness", type=float_range(0, 100), metavar="PCT",
                    help="uniqueness ratio (%%)")
     g.add_argument("--border", choices=BORDERS, help="window at the image edge: invalid or clip")
     g.add_argument("--fill", action="store_true", default=None,
                    help="fill invalid pixels from the farther neighbour")
+    g.add_argument("--no-fill", dest="fill", action="store_false", default=None,
+                   help="leave invalid pixels without a disparity")
+    g.add_argument("--paths", type=int, choices=SGM_PATHS,
+                   help="aggregation paths of the own SGM")
     g.add_argument("--median", type=int, choices=(0, 3, 5), help="median filter size")
+    g.add_argument("--subpixel", dest="subpixel", action="store_true", default=None,
+                   help="sub-pixel disparities (a fit through the costs beside the winner)")
     g.add_argument("--no-subpixel", dest="subpixel", action="store_false", default=None,
-                   help="whole-pixel disparities (no parabola fit)")
+                   help="whole-pixel disparities (the own SGM's default)")
     g.add_argument("--grey", dest="colour", action="store_false", default=None,
                    help="match on grey even when the images have colour")
 
@@ -84,18 +107,28 @@ def add_matcher_options(p: argparse.ArgumentParser) -> None:
 _FIELDS = {"matcher": "matcher", "window": "block_size", "num_disp": "num_disparities",
            "min_disp": "min_disparity", "lr_check": "lr_check", "uniqueness": "uniqueness_ratio",
            "border": "border", "fill": "fill", "median": "median", "subpixel": "subpixel",
-           "colour": "colour"}
+           "colour": "colour", "paths": "paths"}
 
 
 def params_from_args(args: argparse.Namespace) -> MatcherParams:
-    """The --params file (or defaults) overridden by the options given on the command line."""
-    base = load_params(args.params)[0] if args.params else MatcherParams()
+    """The --params file, else the --matcher's measured defaults (MatcherParams.for_matcher),
+    overridden by the options given on the command line."""
+    if args.params:
+        base = load_params(args.params)[0]
+    else:
+        base = MatcherParams.for_matcher(args.matcher or MatcherParams.matcher)
     changes = {f: getattr(args, a) for a, f in _FIELDS.items() if getattr(args, a) is not None}
+    if changes.get("lr_check") == -1.0:
+        changes["lr_check"] = None
     return base.replace(**changes).validate()
 
 
 def num_disp_given(args: argparse.Namespace) -> bool:
-    """Whether the disparity range came from the user (option, or a params file that fixes it
-    rather than storing a policy)."""
-    return args.num_disp is not None or (args.params is not None
-                                         and load_disparity_range(args.params) is None)
+    """Whether the disparity range came from the user: the option, or a params file whose
+    [matcher] table fixes it (num_disparities) rather than storing a [disparity_range] policy.
+    A params file with neither keeps the scene's own range policy."""
+    if args.num_disp is not None:
+        return True
+    if args.params is None or load_disparity_range(args.params) is not None:
+        return False
+    return "num_disparities" in load_matcher_table(args.params)

@@ -13,6 +13,7 @@ import numpy as np
 from host.errors import HostError
 from host.stereo import block_matching as bm
 from host.stereo import sad, sgm
+from host.stereo.cost import census_ad_volume, match_histogram
 from host.stereo.grey import to_grey
 from host.stereo.heap import keep_freed_blocks
 from host.stereo.opencv_backend import opencv_disparity
@@ -22,6 +23,8 @@ from host.stereo.subpixel import DEFAULT_FITS, FIT_NONE, FITS
 
 SGM_P1 = 8  # default SGM penalties per pixel of the cost box (census bits)
 SGM_P2 = 32
+SGM_MIXED_P1 = 18  # the same with the intensity term (MatcherParams.intensity_weight > 0)
+SGM_MIXED_P2 = 72
 # pixel-disparities (about 1.5 ms of SAD on one core) below which a match runs on the calling
 # thread alone: waking numba's thread pool costs more than it saves there, and on a loaded
 # machine a sleeping worker took 7-40 ms to join a 0.2 ms match of the servo's marker window
@@ -109,10 +112,13 @@ def sad_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
 
 
 def sgm_penalties(p: MatcherParams) -> tuple[int, int]:
-    """(P1, P2) for the own SGM: p.p1 / p.p2 when set, else defaults per box-summed census."""
+    """(P1, P2) for the own SGM: p.p1 / p.p2 when set, else the defaults per pixel of the cost
+    box: SGM_P1 / SGM_P2 for census alone, SGM_MIXED_P1 / SGM_MIXED_P2 with the intensity term
+    (its costs span more; measured on the ten shared scenes, docs/stereo.md)."""
     area = p.block_size ** 2
-    p1 = p.p1 or SGM_P1 * area
-    return p1, max(p.p2 or SGM_P2 * area, p1)
+    base1, base2 = (SGM_MIXED_P1, SGM_MIXED_P2) if p.intensity_weight > 0 else (SGM_P1, SGM_P2)
+    p1 = p.p1 or base1 * area
+    return p1, max(p.p2 or base2 * area, p1)
 
 
 _VOLUMES = threading.local()
@@ -137,15 +143,30 @@ NO_VOLUME = np.empty((0, 0, 0), dtype=np.uint16)
 
 
 def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.ndarray:
-    """The own census + semi-global matcher (host/stereo/sgm.py) on grey."""
+    """The own census + semi-global matcher (host/stereo/sgm.py): census of grey, the
+    intensity term on colour (p.colour) or grey. The cost comes from
+    the census rows inside the aggregation when it is census alone (window 1), else from a
+    cost volume (host/stereo/cost.py: the intensity term, the outside cost; the box sum)."""
     gl, gr = to_grey(left), to_grey(right)
     cl, cr = [sgm.census(cv2.copyMakeBorder(g, sgm.CENSUS_H, sgm.CENSUS_H, sgm.CENSUS_W,
                                             sgm.CENSUS_W, cv2.BORDER_REPLICATE))
               for g in (gl, gr)]
     vol = NO_VOLUME
-    if p.block_size > 1:
+    if p.intensity_weight > 0 or p.outside_cost != sgm.CENSUS_BITS:
+        pl, pr = _planes(left, p.colour), _planes(right, p.colour)
+        # the intensity term sees the right image with the left one's levels (per channel),
+        # the table taken from the columns both cameras see (not the strip beside each edge)
+        cut = min(p.min_disparity + p.num_disparities, gl.shape[1] // 2)
+        pr = np.stack([match_histogram(b, a, b[:, :b.shape[1] - cut], a[:, cut:])
+                       for a, b in zip(pl, pr)])
         vol = np.empty((*gl.shape, p.num_disparities), dtype=np.uint16)
-        vol = sgm.box_sum(sgm.hamming_volume(cl, cr, p.min_disparity, vol), p.block_size)
+        vol = census_ad_volume(cl, cr, pl, pr, p.min_disparity, float(p.intensity_weight),
+                               p.intensity_cap, p.outside_cost, vol)
+    elif p.block_size > 1:
+        vol = np.empty((*gl.shape, p.num_disparities), dtype=np.uint16)
+        vol = sgm.hamming_volume(cl, cr, p.min_disparity, vol)
+    if p.block_size > 1:
+        vol = sgm.box_sum(vol, p.block_size)
     p1, p2 = sgm_penalties(p)
     want_right = p.lr_check is not None
     # the 5-path pass decides each row as it goes: no sum volume
@@ -157,7 +178,10 @@ def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
                                float(p.uniqueness_ratio), subpixel_fit(p), want_right, False)
     del cl, crrev, vol
     if want_right:
-        disp_l = lr_consistency(disp_l, disp_r, float(p.lr_check))
+        # the right map has whole pixels: with a sub-pixel left map a tolerance under half a
+        # pixel (LR 0, the default) means the same winner, not no sub-pixel result at all
+        tol = float(p.lr_check)
+        disp_l = lr_consistency(disp_l, disp_r, max(tol, 0.5) if subpixel_fit(p) else tol)
     if p.border == "invalid":
         # the census (and box) window of these pixels leaves the image
         ry, rx = sgm.CENSUS_H + p.block_size // 2, sgm.CENSUS_W + p.block_size // 2
@@ -185,7 +209,8 @@ def compute_disparity(left: np.ndarray, right: np.ndarray, params: MatcherParams
 
 def matched_on(image: np.ndarray, p: MatcherParams) -> str:
     """"colour" when the matcher p names matches on image's BGR channels, else "grey"."""
-    colour = p.matcher in ("sad", "ssd", "opencv-sgbm") and p.colour
+    colour = p.colour and (p.matcher in ("sad", "ssd", "opencv-sgbm")
+                           or (p.matcher == "sgm" and p.intensity_weight > 0))
     return "colour" if colour and image.ndim == 3 and image.shape[2] >= 3 else "grey"
 
 

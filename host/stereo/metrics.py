@@ -47,3 +47,34 @@ def evaluate(disp: np.ndarray, gt: np.ndarray, mask: np.ndarray | None = None,
     bad = (n - has.sum() + (err > rho).sum()) / n
     rms = float(np.sqrt(np.mean(err * err))) if err.size else float("nan")
     return Score(bad=100.0 * float(bad), density=100.0 * float(has.mean()), rms=rms, n=n)
+
+
+REGIONS = ("nonocc", "all", "disc")  # Middlebury v2's three regions, in its table's order
+
+
+def regions(gt: np.ndarray, masks: dict[str, np.ndarray]) -> dict[str, np.ndarray | None]:
+    """Middlebury v2's regions of a scene as evaluate's masks (None = every pixel with known
+    ground truth): nonocc and disc from their masks (absent: not scored, left out), all from
+    all.png where the scene has it, else every known pixel."""
+    out: dict[str, np.ndarray | None] = {}
+    if "nonocc" in masks:
+        out["nonocc"] = masks["nonocc"]
+    out["all"] = masks.get("all")
+    if "disc" in masks:
+        out["disc"] = masks["disc"]
+    return out
+
+
+def round_submission(disp: np.ndarray, scale: float) -> np.ndarray:
+    """disp as an 8-bit Middlebury v2 submission stores it: value round(d * scale) clipped to
+    0..255, read back as value / scale px. A pixel with no disparity stays NaN (bad)."""
+    if not (np.isfinite(scale) and scale > 0):
+        raise HostError(f"ground-truth scale must be positive to round as 8 bits, got {scale}")
+    out = np.clip(np.rint(disp.astype(np.float64) * scale), 0, 255) / scale
+    return out.astype(np.float32)
+
+
+def middlebury(disp: np.ndarray, gt: np.ndarray, masks: dict[str, np.ndarray],
+               rho: float = 1.0) -> dict[str, Score]:
+    """Scores over each of Middlebury v2's regions the scene has (see regions)."""
+    return {name: evaluate(disp, gt, mask, rho) for name, mask in regions(gt, masks).items()}

@@ -12,6 +12,14 @@ BORDERS = ("invalid", "clip")
 SUBPIXEL_FITS = ("auto", "parabola", "equiangular")
 SGM_PATHS = (4, 5, 8)
 SGBM_MODES = {"sgbm": 0, "hh": 1, "sgbm3way": 2, "hh4": 3}
+CENSUS_BITS = 62  # bits of the own SGM's 9x7 census (host.stereo.sgm.CENSUS_BITS)
+# each matcher's measured best where it differs from the dataclass defaults: own SGM measured on
+# the ten shared Middlebury scenes, leave-one-out (docs/stereo.md, "SGM defaults")
+MATCHER_DEFAULTS: dict[str, dict[str, Any]] = {
+    "sgm": {"block_size": 1, "border": "clip", "lr_check": 0.0, "uniqueness_ratio": 30.0,
+            "fill": True, "median": 5, "paths": 4, "subpixel": False,
+            "intensity_weight": 1.0, "intensity_cap": 20, "outside_cost": 23},
+}
 
 
 @dataclass(frozen=True)
@@ -26,7 +34,13 @@ class MatcherParams:
     to the image; own matchers only); median = median-filter size
     applied after filling (0 = off); fill = fill invalid pixels from the farther valid neighbour;
     paths = aggregation paths of the own SGM: 5 (left, right and the three from above, in one
-    pass; the default, within SGBM 3WAY's time), 8 or 4 (left, right, up, down).
+    pass), 8 or 4 (left, right, up, down); intensity_weight, intensity_cap = the own SGM's
+    intensity term added to census (weight per grey level of |difference|, capped at cap grey
+    levels; 0 = census alone); outside_cost = the own SGM's cost of a candidate whose right
+    pixel lies outside the image (CENSUS_BITS, the census maximum, when not lowered).
+
+    The dataclass defaults are the plain matcher; for_matcher gives each matcher's measured
+    best, which is what the commands start from (docs/stereo.md).
     """
 
     matcher: str = "sad"
@@ -49,6 +63,15 @@ class MatcherParams:
     p2: int = 0
     mode: str = "sgbm"
     paths: int = 5
+    intensity_weight: float = 0.0
+    intensity_cap: int = 20
+    outside_cost: int = CENSUS_BITS
+
+    @classmethod
+    def for_matcher(cls, matcher: str = "sad") -> MatcherParams:
+        """The measured default configuration of a matcher (MATCHER_DEFAULTS), else the plain
+        dataclass defaults with that matcher."""
+        return cls(matcher=matcher, **MATCHER_DEFAULTS.get(matcher, {}))
 
     def replace(self, **changes: Any) -> MatcherParams:
         return replace(self, **changes)
@@ -102,6 +125,13 @@ class MatcherParams:
         if self.mode not in SGBM_MODES:
             raise HostError(f"unknown SGBM mode {self.mode!r} "
                             f"(choose from {', '.join(SGBM_MODES)})")
+        if not 0.0 <= self.intensity_weight <= 8.0:
+            raise HostError(f"intensity weight must be in 0..8, got {self.intensity_weight}")
+        if not 0 <= self.intensity_cap <= 255:
+            raise HostError(f"intensity cap must be in 0..255 grey levels, "
+                            f"got {self.intensity_cap}")
+        if not 0 <= self.outside_cost <= 1024:
+            raise HostError(f"outside cost must be in 0..1024, got {self.outside_cost}")
         if self.paths not in SGM_PATHS:
             raise HostError(f"paths must be 4, 5 or 8 (own SGM), got {self.paths}")
         if width is not None:

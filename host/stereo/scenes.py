@@ -30,6 +30,7 @@ class Scene:
     gt: np.ndarray | None = None
     masks: dict[str, np.ndarray] = field(default_factory=dict)
     max_disparity: float | None = None
+    scale: float | None = None  # stored 8-bit ground-truth value per px, where the layout has one
 
     def num_disparities(self, multiple: int = 16) -> int:
         """Smallest multiple of `multiple` above the largest ground-truth disparity."""
@@ -94,7 +95,7 @@ def _load_shared(d: Path) -> Scene:
         masks["disc"] = _mask(d / "disc.png")
     return Scene(meta.get("scene", d.name), read_image(d / "left.png"),
                  read_image(d / "right.png"), _gt_png(d / "disp_left.png", scale), masks,
-                 meta.get("max_disparity"))
+                 meta.get("max_disparity"), scale)
 
 
 def _load_2003(d: Path, scale: float | None) -> Scene:
@@ -104,14 +105,15 @@ def _load_2003(d: Path, scale: float | None) -> Scene:
     if (d / "nonocc.png").exists():
         masks["nonocc"] = _mask(d / "nonocc.png")
     return Scene(d.name, read_image(d / "im2.png"), read_image(d / "im6.png"),
-                 _gt_png(d / "disp2.png", s), masks)
+                 _gt_png(d / "disp2.png", s), masks, scale=s)
 
 
 def _load_2005(d: Path, scale: float | None) -> Scene:
     # 2005/2006: full size ~1300-1400 px wide has scale 1, half 2, third 3.
     left = read_image(d / "view1.png")
     s = scale or float(max(1, round(1330 / left.shape[1])))
-    return Scene(d.name, left, read_image(d / "view5.png"), _gt_png(d / "disp1.png", s))
+    return Scene(d.name, left, read_image(d / "view5.png"), _gt_png(d / "disp1.png", s),
+                 scale=s)
 
 
 def _calib(path: Path) -> dict[str, str]:

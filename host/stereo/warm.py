@@ -27,7 +27,8 @@ def variants() -> list[MatcherParams]:
             MatcherParams(matcher="ssd", lr_check=1.0),
             MatcherParams(matcher="ncc", block_size=5, lr_check=1.0, border="clip"),
             MatcherParams(matcher="sgm", block_size=1, lr_check=1.0, fill=True),
-            MatcherParams(matcher="sgm", block_size=3, uniqueness_ratio=10)]
+            MatcherParams(matcher="sgm", block_size=3, uniqueness_ratio=10),
+            MatcherParams.for_matcher("sgm")]  # the cost volume with the intensity term
     return out
 
 
