@@ -6,7 +6,6 @@ import argparse
 import contextlib
 import signal
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -83,14 +82,12 @@ def _run_simavr(args: argparse.Namespace) -> int:
     from host.emulator import build
     from host.emulator.simavr import SimavrPty
 
-    with tempfile.TemporaryDirectory() as d:
-        harness = build.simavr_harness(Path(d))
-        with SimavrPty(harness, build.firmware_elf()) as sim:
-            print(sim.path, flush=True)
-            print(f"the firmware ELF runs in simavr on {sim.path} (Ctrl-C to stop)",
-                  file=sys.stderr)
-            with contextlib.suppress(KeyboardInterrupt):
-                time.sleep(args.duration if args.duration is not None else 1e9)
+    with SimavrPty(build.simavr_harness(), build.firmware_elf()) as sim:
+        print(sim.path, flush=True)
+        print(f"the firmware ELF runs in simavr on {sim.path} (Ctrl-C to stop)",
+              file=sys.stderr)
+        with contextlib.suppress(KeyboardInterrupt):
+            time.sleep(args.duration if args.duration is not None else 1e9)
     return 0
 
 
