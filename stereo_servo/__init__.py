@@ -22,11 +22,20 @@ def shadowing() -> str | None:
 
 
 def main() -> int:
-    """Run the CLI (host.cli.main), or one line and exit status 2 when host is shadowed."""
+    """Run the CLI (host.cli.main), or one line and exit status 2 when host is shadowed; Ctrl-C
+    while the libraries load (before the CLI handles it) is one line and 130 too."""
+    name = Path(sys.argv[0]).name if Path(sys.argv[0]).name in NAMES else "stereo-servo"
     problem = shadowing()
     if problem:
-        print(f"stereo-servo: error: {problem}", file=sys.stderr)
+        print(f"{name}: error: {problem}", file=sys.stderr)
         return 2
-    from host.cli import main as cli_main
+    try:
+        from host.cli import main as cli_main
 
-    return cli_main()
+        return cli_main()  # which handles Ctrl-C itself once the command runs
+    except KeyboardInterrupt:
+        print(f"{name}: interrupted", file=sys.stderr)
+        return 130
+
+
+NAMES = ("host", "stereo-servo")

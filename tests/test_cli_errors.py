@@ -5,6 +5,7 @@ data stay inside the folder given, outputs keep the umask's mode, all-or-nothing
 from __future__ import annotations
 
 import contextlib
+import importlib.util
 import json
 import os
 import shutil
@@ -163,6 +164,12 @@ ROWS = [
     # ports
     (["servo", "--camera", "replay:{replay}", "--port", "{tmp}/no-such-port"],
      "no-such-port: no such device"),
+    # the simulated Uno's flash: saved where it can be, and only for --uno
+    (["emulate", "--uno", "--flash", "{tmp}/nodir/f.bin"], "--flash {tmp}/nodir/f.bin: no such"),
+    (["emulate", "--flash", "{tmp}/f.bin"], "--flash is the simulated Uno's flash"),
+    # Ray: an address where nothing listens answers at once (loopback only)
+    *([(["tune", "--ray", "127.0.0.1:1"], "--ray 127.0.0.1:1: no Ray cluster answers there")]
+      if importlib.util.find_spec("ray") else []),
 ]
 
 
