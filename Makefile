@@ -37,7 +37,7 @@ demo: venv
 	@mkdir -p $(OUT)
 	$(BIN)/host eval --picture $(OUT)
 	$(BIN)/host eval --matcher ncc --window 5 --border clip --lr-check 1 --fill --median 5
-	$(BIN)/host tune --border clip --out $(OUT)/tuned.toml --plot $(OUT)/tuning.png
+	$(BIN)/host tune --method paper --border clip --out $(OUT)/tuned.toml --plot $(OUT)/tuning.png
 	$(BIN)/host servo --sim --border clip --num-disp 48 --log $(OUT)/servo.csv --plot $(OUT)/servo.png
 	@echo "pictures: $(OUT)/motorcycle.png (disparity), $(OUT)/tuning.png (tuning), $(OUT)/servo.png (servo run)"
 

@@ -236,7 +236,7 @@ def self_supervised(space: Space, names: list[str], scenes, gt_table: np.ndarray
     gt_best = list(gt_table.min(axis=0))
     for s in unseen:
         s.masks["nonocc"] = nonocc_from_gt(s.gt)
-        r = POLICY.resolve(s.left, s.right, gt=s.gt)
+        r = POLICY.resolve(s.left, s.right, gt=s.gt, nonocc=s.masks["nonocc"])
         gt_best.append(cached_table("grid", GroundTruthScore([s], [r]), space, [s], [r], cache,
                                     workers).min())
         defaults = defaults | {s.name: GroundTruthScore([s], [r])(DEFAULTS)[0]}
@@ -350,7 +350,8 @@ def main() -> int:
     names = args.scenes.split(",") if args.scenes else [
         d.name for d in sorted(root.iterdir()) if (d / "meta.json").exists()]
     scenes = [load_scene(root / n) for n in names]
-    ranges = [POLICY.resolve(s.left, s.right, gt=s.gt) for s in scenes]
+    ranges = [POLICY.resolve(s.left, s.right, gt=s.gt, nonocc=s.masks.get("nonocc"))
+              for s in scenes]
     if args.ray_timing:
         ray_timing(scenes, ranges, args.workers)
         return 0

@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
+import host
 from host.commands import calibrate, cameras, capture, disparity, emulate, servo, tune, view
 from host.commands import eval as eval_cmd
 from host.errors import describe
@@ -64,9 +66,10 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(prog: str = "host") -> argparse.ArgumentParser:
     parser = _Parser(
-        prog="host", description="stereo-servo host: stereo matching, tuning and the robot servo")
+        prog=prog, description="stereo-servo host: stereo matching, tuning and the robot servo")
+    parser.add_argument("--version", action="version", version=f"stereo-servo {host.__version__}")
     parser.add_argument("--debug", action="store_true",
                         help="show the traceback of an error instead of one line")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND",
@@ -91,7 +94,8 @@ def main(argv: list[str] | None = None) -> int:
     """Run a subcommand. Bad input (a HostError, an OSError, a library's error on the user's
     data) becomes one line on stderr and exit status 2; SIGINT, SIGTERM and SIGHUP end it like
     Ctrl-C with status 128+n; --debug shows the traceback instead."""
-    args = build_parser().parse_args(argv)
+    prog = "stereo-servo" if Path(sys.argv[0]).name == "stereo-servo" else "host"
+    args = build_parser(prog).parse_args(argv)
     try:
         with signals_interrupt():
             return int(args.run(args))
@@ -102,7 +106,7 @@ def main(argv: list[str] | None = None) -> int:
         said = None if args.debug or isinstance(e, SystemExit) else describe(e)
         if said is None:
             raise
-        print(f"host {args.command}: {said[1]}", file=sys.stderr)
+        print(f"{prog} {args.command}: {said[1]}", file=sys.stderr)
         return said[0]
 
 

@@ -5,6 +5,7 @@ data stay inside the folder given, outputs keep the umask's mode, all-or-nothing
 from __future__ import annotations
 
 import contextlib
+import importlib.util
 import json
 import os
 import shutil
@@ -81,7 +82,40 @@ def files(tmp_path: Path) -> dict[str, Path]:
     f["replay"].mkdir()
     cv2.imwrite(str(f["replay"] / "left_000.png"), grey)
     cv2.imwrite(str(f["replay"] / "right_000.png"), grey)
+    f["l16"] = tmp_path / "l16.png"
+    cv2.imwrite(str(f["l16"]), grey.astype(np.uint16) * 256)
+    h, w = grey.shape
+    values = np.full((h, w), 10.0, "<f4").tobytes()
+    for name, header, body in (("pfm_abc", b"Pf\nabc 5\n-1\n", values),
+                               ("pfm_negsize", b"Pf\n-160 120\n-1\n", values),
+                               ("pfm_colour", b"PF\n%d %d\n-1\n" % (w, h), values * 3),
+                               ("pfm_nan", b"Pf\n%d %d\nnan\n" % (w, h), values),
+                               ("pfm_negative", b"Pf\n%d %d\n-1\n" % (w, h),
+                                np.full((h, w), -49.0, "<f4").tobytes()),
+                               ("pfm_unknown", b"Pf\n%d %d\n-1\n" % (w, h),
+                                np.full((h, w), np.inf, "<f4").tobytes())):
+        f[name] = _scene_2014(tmp_path / name, grey, header + body)
+    f["calib_banana"] = _scene_2014(tmp_path / "calib_banana", grey,
+                                    b"Pf\n%d %d\n-1\n" % (w, h) + values, "ndisp=banana\n")
+    f["calib_list"] = tmp_path / "list.yml"
+    f["calib_list"].write_text("%YAML:1.0\n---\n- 1\n- 2\n")
+    f["calib_ocv"] = tmp_path / "calib.yml"
+    f["calib_ocv"].write_text("%YAML:1.0\n---\nimage_size: [160, 120]\n")
+    f["ros_equi"] = tmp_path / "right.yaml"
+    f["ros_equi"].write_text("image_width: 160\nimage_height: 120\ncamera_matrix: {}\n"
+                             "distortion_model: equidistant\n")
     return f
+
+
+def _scene_2014(folder: Path, grey: np.ndarray, pfm: bytes, calib: str | None = None) -> Path:
+    """A Middlebury 2014 layout (im0, im1, disp0GT.pfm, calib.txt) with this PFM's bytes."""
+    folder.mkdir()
+    cv2.imwrite(str(folder / "im0.png"), grey)
+    cv2.imwrite(str(folder / "im1.png"), grey)
+    (folder / "disp0GT.pfm").write_bytes(pfm)
+    if calib is not None:
+        (folder / "calib.txt").write_text(calib)
+    return folder
 
 
 def _tree(root: Path) -> dict[str, tuple[int, float]]:
@@ -163,6 +197,28 @@ ROWS = [
     # ports
     (["servo", "--camera", "replay:{replay}", "--port", "{tmp}/no-such-port"],
      "no-such-port: no such device"),
+    # the simulated Uno's flash: saved where it can be, and only for --uno
+    (["emulate", "--uno", "--flash", "{tmp}/nodir/f.bin"], "--flash {tmp}/nodir/f.bin: no such"),
+    (["emulate", "--flash", "{tmp}/f.bin"], "--flash is the simulated Uno's flash"),
+    # images of two depths; ground truth PFMs and calib.txt that are wrong in their own ways
+    (["disparity", "{l16}", "{l}", "-o", "{tmp}/o.png"], "l16.png: a 16-bit image"),
+    (["eval", "{pfm_abc}"], "PFM size 'abc 5' is not two positive integers"),
+    (["eval", "{pfm_negsize}"], "PFM size '-160 120' is not two positive integers"),
+    (["eval", "{pfm_colour}"], "disp0GT.pfm: a colour PFM (PF)"),
+    (["eval", "{pfm_nan}"], "PFM scale 'nan' is not a finite non-zero number"),
+    (["eval", "{pfm_negative}"], "negative disparities (down to -49 px)"),
+    (["eval", "{pfm_unknown}"], "disp0GT.pfm: no known disparity"),
+    (["eval", "{calib_banana}"], "calib.txt: ndisp='banana' is not a number"),
+    # calibrations: a YAML list, three names, an OpenCV file given as a ROS one, fisheye
+    (SERVO + ["--calib", "{calib_list}"], "list.yml: not an OpenCV calibration file (its top"),
+    (SERVO + ["--calib", "a,b,c"], "--calib a,b,c: give one OpenCV file, or two ROS"),
+    (SERVO + ["--calib", "{calib_ocv},{ros_equi}"], "calib.yml is an OpenCV stereo calibration"),
+    (SERVO + ["--calib", "{ros_equi},{ros_equi}"], "distortion_model 'equidistant' is not"),
+    # cameras: a sysfs root that is not there
+    (["cameras", "--sysfs", "{tmp}/missing"], "--sysfs {tmp}/missing: no such folder"),
+    # Ray: an address where nothing listens answers at once (loopback only)
+    *([(["tune", "--ray", "127.0.0.1:1"], "--ray 127.0.0.1:1: no Ray cluster answers there")]
+      if importlib.util.find_spec("ray") else []),
 ]
 
 

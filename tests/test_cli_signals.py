@@ -50,3 +50,19 @@ def test_a_signal_stops_the_robot_and_keeps_the_log(tmp_path: Path, signum: int)
     rows = log.read_text().splitlines()
     assert rows[0].startswith("t,phase") and len(rows) > 2
     assert plot.read_bytes().startswith(b"\x89PNG")
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP])
+def test_a_signal_ends_the_emulator_with_128_plus_n(tmp_path: Path, signum: int) -> None:
+    proc = subprocess.Popen([sys.executable, "-m", "host", "emulate"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    try:
+        assert proc.stdout is not None and proc.stdout.readline().startswith("/dev/pts/")
+        time.sleep(0.5)
+        proc.send_signal(signum)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        proc.kill()
+    assert proc.returncode == 128 + signum, err
+    name = "" if signum == signal.SIGINT else f" ({signal.Signals(signum).name})"
+    assert err.splitlines()[-1] == f"host emulate: interrupted{name}"

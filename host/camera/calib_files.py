@@ -109,6 +109,9 @@ def load_opencv(path: str) -> Calibration:
         raise _syntax_error(path, e) from None
     if not ok:
         raise CameraError(f"{path}: not an OpenCV calibration file")
+    if not fs.root().isMap():
+        raise CameraError(f"{path}: not an OpenCV calibration file (its top level is not a map "
+                          "of names to matrices)")
     size = _image_size(path, fs.getNode("image_size"))
     mats = {k: _matrix(path, fs, k) for k in MATRICES}
     missing = [k for k, v in mats.items() if v is None]
@@ -123,8 +126,11 @@ def load_opencv(path: str) -> Calibration:
 def load_calibration(spec: str) -> Calibration:
     """--calib: an OpenCV file, or LEFT.yaml,RIGHT.yaml (ROS camera_info)."""
     if "," in spec:
-        left, _, right = spec.partition(",")
-        return load_ros(left, right)
+        parts = spec.split(",")
+        if len(parts) != 2 or not all(parts):
+            raise CameraError(f"--calib {spec}: give one OpenCV file, or two ROS camera_info "
+                              f"files as LEFT.yaml,RIGHT.yaml (got {len(parts)} names)")
+        return load_ros(*parts)
     return load_opencv(spec)
 
 
@@ -176,15 +182,28 @@ def _ros_field(path: str, info: dict, key: str, shape: tuple[int, int] | None) -
     return m
 
 
+ROS_MODELS = ("plumb_bob", "rational_polynomial")  # what ros_text writes, cv2's model
+
+
 def _read_ros(path: str) -> tuple[tuple[int, int], dict[str, np.ndarray]]:
+    text = _read_text(path)
+    if text.startswith("%YAML:1.0") or "!!opencv-matrix" in text:  # OpenCV's FileStorage
+        raise CameraError(f"{path} is an OpenCV stereo calibration (host calibrate --out): pass "
+                          f"it alone as --calib {path}; LEFT,RIGHT takes two ROS camera_info "
+                          "files")
     try:
-        info = yaml.safe_load(_read_text(path))
+        info = yaml.safe_load(text)
     except yaml.YAMLError as e:
         mark = getattr(e, "problem_mark", None)
         where = f" at line {mark.line + 1}" if mark else ""
         raise CameraError(f"{path}: not readable as YAML (a syntax error{where})") from None
     if not isinstance(info, dict) or "camera_matrix" not in info:
         raise CameraError(f"{path}: not a ROS camera_info file (no camera_matrix)")
+    model = info.get("distortion_model", "plumb_bob")
+    if model not in ROS_MODELS:
+        raise CameraError(f"{path}: distortion_model {model!r} is not supported (only "
+                          f"{' and '.join(ROS_MODELS)}, the models OpenCV's stereo calibration "
+                          "fits)")
     try:
         size = (int(info["image_width"]), int(info["image_height"]))
     except (KeyError, TypeError, ValueError):

@@ -6,6 +6,7 @@ import argparse
 from pathlib import Path
 
 from host.camera.discovery import SYSFS, discover
+from host.errors import HostError
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -15,6 +16,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if not args.sysfs.is_dir():
+        raise HostError(f"--sysfs {args.sysfs}: no such folder")
+    if args.sysfs != SYSFS and not (args.sysfs / "class").is_dir():
+        raise HostError(f"--sysfs {args.sysfs}: not a sysfs tree (no class/ in it)")
     cameras = discover(args.sysfs)
     if not cameras:
         print(f"no USB cameras under {args.sysfs}/class/video4linux")

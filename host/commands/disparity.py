@@ -8,6 +8,7 @@ import time
 from pathlib import Path
 
 import cv2
+import numpy as np
 
 from host.commands.options import add_matcher_options, params_from_args
 from host.errors import HostError
@@ -28,13 +29,23 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(run=run)
 
 
+def _eight_bit(path, img: np.ndarray) -> np.ndarray:
+    """The image as the matchers take it (8-bit grey or BGR, alpha dropped), or one line."""
+    if img.dtype != np.uint8:
+        raise HostError(f"{path}: a {8 * img.itemsize}-bit image: the matchers take 8-bit "
+                        "views (convert both, e.g. convert IN -depth 8 OUT)")
+    if img.ndim == 3 and img.shape[2] == 4:
+        return cv2.cvtColor(img, cv2.COLOR_BGRA2BGR)
+    return img
+
+
 def run(args: argparse.Namespace) -> int:
     check_output(args.out, IMAGE, "--out")
     if args.npy:
         check_output(args.npy, "npy", "--npy")
     params = params_from_args(args)
-    left = read_image(args.left, cv2.IMREAD_UNCHANGED)
-    right = read_image(args.right, cv2.IMREAD_UNCHANGED)
+    left, right = (_eight_bit(path, read_image(path, cv2.IMREAD_UNCHANGED))
+                   for path in (args.left, args.right))
     if left.ndim != right.ndim and params.colour:  # colour matching needs two colour views
         kinds = {2: "grey", 3: "colour"}
         raise HostError(f"{args.left} is {kinds[left.ndim]} and {args.right} "

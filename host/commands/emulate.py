@@ -3,16 +3,17 @@
 from __future__ import annotations
 
 import argparse
-import contextlib
-import signal
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 from host.commands.options import NON_NEGATIVE, POSITIVE, SEED, float_range
 from host.emulator.emulator import Emulator, Faults, PtyService
 from host.errors import HostError
+from host.files import check_folder
+
+FLASH_DEFAULT = Path("uno-flash.bin")
+RESET_LINES_PER_S = 3  # an erased chip resets ~60 times a second: say so once, not 60 times
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -22,7 +23,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--uno", action="store_true",
                    help="a simulated Arduino Uno with its bootloader: program it with avrdude "
                         "or platformio, then talk to the firmware it runs")
-    p.add_argument("--flash", type=Path, default=Path("uno-flash.bin"), metavar="FILE",
+    p.add_argument("--flash", type=Path, default=FLASH_DEFAULT, metavar="FILE",
                    help="--uno: the board's application flash, kept between runs "
                         "(absent = an erased chip; default %(default)s)")
     p.add_argument("--drop", type=RATE, default=0.0, metavar="RATE",
@@ -40,14 +41,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 RATE = float_range(0, 1, hi_open=True)
 
 
-def _interrupt(*_: object) -> None:
-    raise KeyboardInterrupt
-
-
 def run(args: argparse.Namespace) -> int:
-    signal.signal(signal.SIGTERM, _interrupt)  # kill ends it like Ctrl-C
+    """Until --duration (exit 0) or a signal: Ctrl-C, SIGTERM and SIGHUP end it with 128+n
+    (host.cli), the board closed on the way out."""
     if args.simavr and args.uno:
         raise HostError("--simavr and --uno are two different boards: choose one")
+    if args.flash != FLASH_DEFAULT and not args.uno:
+        raise HostError("--flash is the simulated Uno's flash: it goes with --uno")
     if args.simavr or args.uno:
         _no_faults(args)
     if args.simavr:
@@ -62,14 +62,13 @@ def run(args: argparse.Namespace) -> int:
         print(f"emulating the robot on {service.path} (Ctrl-C to stop)", file=sys.stderr)
         last = None
         t_end = None if args.duration is None else time.monotonic() + args.duration
-        with contextlib.suppress(KeyboardInterrupt):
-            while t_end is None or time.monotonic() < t_end:
-                motors = emu.motors()
-                if motors != last:
-                    print(f"t={emu.now_ms / 1000:8.3f} s  motors left {motors[0]:5d} "
-                          f"right {motors[1]:5d} permille", file=sys.stderr, flush=True)
-                    last = motors
-                time.sleep(0.01)
+        while t_end is None or time.monotonic() < t_end:
+            motors = emu.motors()
+            if motors != last:
+                print(f"t={emu.now_ms / 1000:8.3f} s  motors left {motors[0]:5d} "
+                      f"right {motors[1]:5d} permille", file=sys.stderr, flush=True)
+                last = motors
+            time.sleep(0.01)
     return 0
 
 
@@ -83,42 +82,60 @@ def _run_simavr(args: argparse.Namespace) -> int:
     from host.emulator import build
     from host.emulator.simavr import SimavrPty
 
-    with tempfile.TemporaryDirectory() as d:
-        harness = build.simavr_harness(Path(d))
-        with SimavrPty(harness, build.firmware_elf()) as sim:
-            print(sim.path, flush=True)
-            print(f"the firmware ELF runs in simavr on {sim.path} (Ctrl-C to stop)",
-                  file=sys.stderr)
-            with contextlib.suppress(KeyboardInterrupt):
-                time.sleep(args.duration if args.duration is not None else 1e9)
+    with SimavrPty(build.simavr_harness(), build.firmware_elf()) as sim:
+        print(sim.path, flush=True)
+        print(f"the firmware ELF runs in simavr on {sim.path} (Ctrl-C to stop)",
+              file=sys.stderr)
+        time.sleep(args.duration if args.duration is not None else 1e9)
     return 0
 
 
 def _run_uno(args: argparse.Namespace) -> int:
     from host.emulator.uno import SimulatedUno
 
-    if args.flash.exists() and args.flash.is_dir():
+    if args.flash.is_dir():
         raise HostError(f"--flash {args.flash} is a folder; name a file")
+    check_folder(args.flash.parent, "--flash", target=args.flash)  # where a program is saved
     with SimulatedUno(args.flash) as uno:
         print(uno.path, flush=True)
         print(f"a simulated Arduino Uno (optiboot) on {uno.path}, flash in {args.flash}; "
               f"opening the port resets it (Ctrl-C to stop)", file=sys.stderr, flush=True)
         t_end = None if args.duration is None else time.monotonic() + args.duration
         seen_resets, seen_saves, seen_crashes, last = 0, 0, 0, None
-        with contextlib.suppress(KeyboardInterrupt):
-            while t_end is None or time.monotonic() < t_end:
-                for r in uno.resets[seen_resets:]:
-                    print(f"reset at {r.cycle / 16e6:8.3f} s ({r.flags})", file=sys.stderr)
-                for c in uno.crashes[seen_crashes:]:
-                    print(f"the program stopped the simulated CPU at {c / 16e6:8.3f} s; it "
-                          f"restarts at the next reset (open the port)", file=sys.stderr)
-                for n in uno.saves[seen_saves:]:
-                    print(f"programmed: {n} bytes saved to {args.flash}", file=sys.stderr)
-                seen_resets, seen_saves = len(uno.resets), len(uno.saves)
-                seen_crashes = len(uno.crashes)
-                if uno.motors() != last:
-                    last = uno.motors()
-                    print(f"motors left {last[0]:5d} right {last[1]:5d} permille",
-                          file=sys.stderr, flush=True)
-                time.sleep(0.01)
+        resets = _ResetLines()
+        while t_end is None or time.monotonic() < t_end:
+            for r in uno.resets[seen_resets:]:
+                resets.add(r, time.monotonic())
+            for c in uno.crashes[seen_crashes:]:
+                print(f"the program stopped the simulated CPU at {c / 16e6:8.3f} s; it "
+                      f"restarts at the next reset (open the port)", file=sys.stderr)
+            for n in uno.saves[seen_saves:]:
+                print(f"programmed: {n} bytes saved to {args.flash}", file=sys.stderr)
+            seen_resets, seen_saves = len(uno.resets), len(uno.saves)
+            seen_crashes = len(uno.crashes)
+            if uno.motors() != last:
+                last = uno.motors()
+                print(f"motors left {last[0]:5d} right {last[1]:5d} permille",
+                      file=sys.stderr, flush=True)
+            time.sleep(0.01)
     return 0
+
+
+class _ResetLines:
+    """Reset lines, at most RESET_LINES_PER_S a second; beyond that one line that says the
+    chip keeps resetting (an erased flash: the bootloader starts over and over)."""
+
+    def __init__(self) -> None:
+        self.window, self.shown, self.said = 0.0, 0, False
+
+    def add(self, r, now: float) -> None:
+        if now - self.window >= 1.0:
+            self.window, self.shown = now, 0
+        self.shown += 1
+        if self.shown <= RESET_LINES_PER_S:
+            print(f"reset at {r.cycle / 16e6:8.3f} s ({r.flags})", file=sys.stderr)
+        elif not self.said:
+            self.said = True
+            print("the chip keeps resetting (an erased flash restarts the bootloader over and "
+                  "over): further resets are not shown; upload a program (make flash PORT=...)",
+                  file=sys.stderr, flush=True)

@@ -86,7 +86,7 @@ def _scene_range(args: argparse.Namespace, params: MatcherParams, scene: Scene
     table = load_disparity_range(args.params) if args.params else None
     if table is not None:
         return apply_range(params, RangePolicy.from_table(table).resolve(
-            scene.left, scene.right, gt=scene.gt))
+            scene.left, scene.right, gt=scene.gt, nonocc=scene.masks.get("nonocc")))
     return params.replace(num_disparities=scene.num_disparities(
         16 if params.matcher.startswith("opencv") else 1))
 

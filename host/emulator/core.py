@@ -4,39 +4,45 @@ library and driven through ctypes: the emulator runs the same code as the robot,
 from __future__ import annotations
 
 import ctypes
-import hashlib
 import os
 import shutil
 import subprocess
 import tempfile
 from pathlib import Path
 
-from host.emulator.build import FIRMWARE, ROOT, BuildFailed, ToolMissing
-from host.errors import HostError
+from host.emulator.build import (
+    CACHE,
+    FIRMWARE,
+    PROTOCOL_C,
+    BuildFailed,
+    ToolMissing,
+    digest,
+    need_sources,
+)
 
 SOURCES = [FIRMWARE / "core" / "robot.c", FIRMWARE / "core" / "drive.c",
-           FIRMWARE / "core" / "link.c", FIRMWARE / "emu" / "board.c",
-           ROOT / "protocol" / "c" / "frame.c"]
-HEADERS = [*sorted((FIRMWARE / "core").glob("*.h")),
-           *sorted((ROOT / "protocol" / "c").glob("*.h")), FIRMWARE / "config.h"]
-CACHE = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "stereo-servo"
+           FIRMWARE / "core" / "link.c", FIRMWARE / "emu" / "board.c", PROTOCOL_C / "frame.c"]
+
+
+def _headers() -> list[Path]:
+    return [*sorted((FIRMWARE / "core").glob("*.h")), *sorted(PROTOCOL_C.glob("*.h")),
+            FIRMWARE / "config.h"]
 
 
 def build_library() -> Path:
-    """Compile the core into a shared library, cached by a hash of its sources."""
-    missing = [p for p in SOURCES if not p.exists()]
-    if missing:
-        raise HostError(f"firmware sources not found ({missing[0]}): run from a source checkout")
+    """Compile the core into a shared library in the user cache, keyed by a hash of its
+    sources (the checkout's, or those the package ships)."""
+    need_sources(*SOURCES, FIRMWARE / "config.h")
     if shutil.which("gcc") is None:
-        raise ToolMissing("gcc not found: the emulator compiles the firmware core natively")
-    digest = hashlib.sha256(b"".join(p.read_bytes() for p in SOURCES + HEADERS)).hexdigest()[:16]
-    lib = CACHE / f"firmware-core-{digest}.so"
+        raise ToolMissing("gcc not found: the emulator compiles the firmware core natively "
+                          "(install gcc)")
+    lib = CACHE / f"firmware-core-{digest(SOURCES + _headers())}.so"
     if lib.exists():
         return lib
     CACHE.mkdir(parents=True, exist_ok=True)
     tmp = lib.with_suffix(f".{os.getpid()}.tmp")
     cmd = ["gcc", "-std=gnu11", "-O2", "-shared", "-fPIC", "-Wall", "-Wextra", "-Werror",
-           f"-I{ROOT / 'protocol' / 'c'}", *map(str, SOURCES), "-o", str(tmp)]
+           f"-I{PROTOCOL_C}", *map(str, SOURCES), "-o", str(tmp)]
     r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode:
         raise BuildFailed(f"building the firmware core failed: {r.stderr.strip()[:300]}")

@@ -3,7 +3,6 @@ application flash kept in a file, UART0 on a pty that avrdude programs and the h
 
 from __future__ import annotations
 
-import os
 import subprocess
 import threading
 from collections.abc import Callable
@@ -23,23 +22,10 @@ F_CPU = 16_000_000
 MCUSR_BITS = {0x01: "PORF", 0x02: "EXTRF", 0x04: "BORF", 0x08: "WDRF"}
 
 
-def program(out_dir: Path) -> Path:
-    """Compile uno.c against libsimavr into out_dir (again when the source is newer)."""
-    build._need("gcc", "gcc")
-    if not (build.SIMAVR_INCLUDE / "sim_avr.h").exists():
-        raise build.ToolMissing("simavr headers not found: install simavr and libsimavr-dev")
-    exe = out_dir / "simavr-uno"
-    if exe.exists() and exe.stat().st_mtime >= SOURCE.stat().st_mtime:
-        return exe
-    out_dir.mkdir(parents=True, exist_ok=True)
-    tmp = out_dir / f"simavr-uno.{os.getpid()}"  # then renamed: a running board keeps its file
-    r = subprocess.run(["gcc", "-std=gnu11", "-O2", "-Wall", "-Wextra", "-Werror",
-                        f"-I{build.SIMAVR_INCLUDE}", str(SOURCE), "-lsimavr", "-o", str(tmp)],
-                       capture_output=True, text=True)
-    if r.returncode:
-        raise build.BuildFailed(f"building the simulated Uno failed:\n{r.stderr}")
-    os.replace(tmp, exe)
-    return exe
+def program(out_dir: Path | None = None) -> Path:
+    """Compile uno.c against libsimavr into out_dir (default: the cache), again when it
+    changes."""
+    return build.simavr_program(SOURCE, "simavr-uno", out_dir)
 
 
 @dataclass(frozen=True)
@@ -62,7 +48,7 @@ class SimulatedUno:
     leaves the chip running. Events (resets, motor outputs, saves) are read as they come.
     """
 
-    def __init__(self, flash: Path, out_dir: Path = build.ROOT / "build" / "simavr",
+    def __init__(self, flash: Path, out_dir: Path | None = None,
                  bootloader: Path | None = OPTIBOOT, autoreset: bool = True) -> None:
         if bootloader is not None and not bootloader.exists():
             raise build.ToolMissing(f"the Uno's bootloader {bootloader} is missing: install "

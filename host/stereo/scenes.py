@@ -15,7 +15,7 @@ import cv2
 import numpy as np
 
 from host.errors import HostError
-from host.stereo.pfm import read_pfm
+from host.stereo.pfm import read_disparity_pfm
 
 DEFAULT_SCENE = "motorcycle"
 
@@ -127,13 +127,14 @@ def _calib(path: Path) -> dict[str, str]:
 
 def _load_2014(d: Path) -> Scene:
     gt_path = d / "disp0GT.pfm" if (d / "disp0GT.pfm").exists() else d / "disp0.pfm"
-    gt = read_pfm(gt_path) if gt_path.exists() else None
-    if gt is not None:
-        gt[~np.isfinite(gt)] = np.nan
+    gt = read_disparity_pfm(gt_path) if gt_path.exists() else None
     max_d = None
     if (d / "calib.txt").exists():
         ndisp = _calib(d / "calib.txt").get("ndisp")
-        max_d = float(ndisp) - 1 if ndisp else None
+        try:
+            max_d = float(ndisp) - 1 if ndisp else None
+        except ValueError:
+            raise HostError(f"{d / 'calib.txt'}: ndisp={ndisp!r} is not a number") from None
     masks = {}
     if (d / "mask0nocc.png").exists():
         masks["nonocc"] = _mask(d / "mask0nocc.png")

@@ -1,7 +1,9 @@
 """The disparity range as a policy derived from each scene, never a tuned constant.
 
 Policies (text form in brackets, as --range takes it and params files store it):
-- ground-truth [ground-truth]: the scene's known disparities, widened by the margin.
+- ground-truth [ground-truth]: the 0.1st to 99.9th percentile of the scene's known disparities
+  in its nonocc region (all known pixels when it has no mask), widened by the margin, so a few
+  stray pixels do not widen the search.
 - depth [depth:NEAR:FAR]: the calibration's depth range in metres, d = focal * baseline / Z.
 - coarse [coarse]: a quick ZNCC pass at half size over half the image width, with a left-right
   and uniqueness check; of its confident matches (away from the border, agreeing with most of
@@ -27,6 +29,7 @@ COARSE_FACTOR = 2
 COARSE_WINDOW = 7  # px at half size
 COARSE_SUPPORT = 16  # of the 24 neighbours in 5x5 within 1 coarse px: not a speckle
 COARSE_PERCENTILES = (0.5, 99.5)
+GT_PERCENTILES = (0.1, 99.9)  # of the nonocc ground truth: loses <= 0.03 % on the ten scenes
 
 
 @dataclass(frozen=True)
@@ -88,11 +91,12 @@ class RangePolicy:
         return cls.parse(str(table["policy"]), float(table.get("margin_px", 4.0)))
 
     def resolve(self, left: np.ndarray, right: np.ndarray, gt: np.ndarray | None = None,
-                focal_baseline: float | None = None, multiple: int = 1) -> tuple[int, int]:
+                focal_baseline: float | None = None, multiple: int = 1,
+                nonocc: np.ndarray | None = None) -> tuple[int, int]:
         """(min_disparity, num_disparities) for this pair; num rounded up to `multiple`.
 
-        gt: ground truth (px, NaN unknown) for ground-truth; focal_baseline: focal_px *
-        baseline_m for depth."""
+        gt: ground truth (px, NaN unknown) and nonocc (bool mask, optional) for ground-truth;
+        focal_baseline: focal_px * baseline_m for depth."""
         if self.kind == "fixed":
             assert self.num is not None
             return 0, _round_up(self.num, multiple)
@@ -100,7 +104,7 @@ class RangePolicy:
             if gt is None or not np.isfinite(gt).any():
                 raise HostError("the ground-truth disparity range needs a scene with ground "
                                 "truth (use --range coarse)")
-            lo, hi = float(np.nanmin(gt)), float(np.nanmax(gt))
+            lo, hi = gt_range(gt, nonocc)
         elif self.kind == "depth":
             if focal_baseline is None:
                 raise HostError("the depth range needs a calibration (--calib)")
@@ -115,6 +119,14 @@ class RangePolicy:
         if lo + num > width // 2:  # never search more than half the image
             num = max(multiple, (width // 2 - lo) // multiple * multiple)
         return lo, num
+
+
+def gt_range(gt: np.ndarray, nonocc: np.ndarray | None = None) -> tuple[float, float]:
+    """(low, high) px: robust percentiles of the known disparities in the nonocc region."""
+    known = np.isfinite(gt)
+    region = known & nonocc if nonocc is not None and (known & nonocc).any() else known
+    lo, hi = np.percentile(gt[region], GT_PERCENTILES)
+    return float(lo), float(hi)
 
 
 def _round_up(n: int, multiple: int) -> int:

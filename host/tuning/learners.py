@@ -11,7 +11,7 @@
   over the run, in episodes that start from a random state or from the best state found so far.
 - grid: every state. random: states drawn without replacement.
 - tpe: Optuna's Tree-structured Parzen Estimator (multivariate), the standard optimiser, as a
-  baseline (optional dependency: pip install 'stereo-servo[tpe]').
+  baseline (Optuna, a dependency: host tune's default method).
 
 The reward is the improvement of the bad-pixel rate, R(s, a) = bad(s) - bad(s') in percentage
 points: positive for a move to a better state, zero for keep. With Q starting at zero, an untried
@@ -251,7 +251,7 @@ def tpe(obj: Run, space: Space, iterations: int, seed: int,
     try:
         import optuna
     except ImportError:
-        raise HostError("--method tpe needs Optuna: pip install 'stereo-servo[tpe]'") from None
+        raise HostError("--method tpe needs Optuna: pip install optuna") from None
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     sampler = optuna.samplers.TPESampler(seed=seed, multivariate=True)
     study = optuna.create_study(sampler=sampler)

@@ -116,5 +116,6 @@ def test_host_cameras_lists_kind_nodes_modes_and_the_spec(tmp_path: Path, capsys
     assert "--camera minoru:1-1" in out and "YUYV 320x240@30, YUYV 640x480@15" in out
     assert "sbs      USB 3-2" in out and "MJPG 2560x720@60/30" in out
     assert "--camera sbs:3-2  (or sbs:/dev/video4" in out
-    assert main(["cameras", "--sysfs", str(tmp_path / "nothing")]) == 0
+    (tmp_path / "empty" / "class").mkdir(parents=True)  # a sysfs tree without cameras
+    assert main(["cameras", "--sysfs", str(tmp_path / "empty")]) == 0
     assert "no USB cameras" in capsys.readouterr().out

@@ -26,6 +26,19 @@ def test_ground_truth_policy_covers_the_known_disparities_with_the_margin() -> N
     assert lo == 8 and lo + num - 1 == 45  # floor(12.3 - 4) .. ceil(40.6 + 4)
 
 
+def test_ground_truth_range_is_robust_to_stray_pixels_and_uses_the_nonocc_region() -> None:
+    rng = np.random.default_rng(0)
+    gt = rng.uniform(21, 70, (100, 200)).astype(np.float32)
+    gt[50, 50] = 3.7  # one stray known pixel widened a 21-70 px scene to 0-71
+    lo, num = RangePolicy("ground-truth", 4).resolve(gt, gt, gt=gt)
+    assert 16 <= lo <= 17 and 73 <= lo + num - 1 <= 74
+    gt[:, :10] = 2.0  # known but occluded: outside the nonocc mask
+    nonocc = np.ones(gt.shape, bool)
+    nonocc[:, :10] = False
+    lo, num = RangePolicy("ground-truth", 4).resolve(gt, gt, gt=gt, nonocc=nonocc)
+    assert 16 <= lo <= 17
+
+
 def test_depth_policy_maps_metres_to_pixels() -> None:
     img = np.zeros((10, 400), np.uint8)
     # focal 426 px, baseline 0.06 m: 0.5 m -> 51.1 px, 4 m -> 6.4 px

@@ -97,7 +97,7 @@ def test_the_paper_learner_is_greedy_equation_6_from_zeros(monkeypatch) -> None:
 
 
 def test_tpe_is_reproducible_and_counts_repeated_trials_once() -> None:
-    pytest.importorskip("optuna", reason="Optuna is not installed (stereo-servo[tpe])")
+    pytest.importorskip("optuna", reason="Optuna is not installed")
     a = tune("tpe", Objective(bowl_4d), FOUR_D, 40, seed=1)
     b = tune("tpe", Objective(bowl_4d), FOUR_D, 40, seed=1)
     assert a.history == b.history and len(a.history) == 40

@@ -45,8 +45,8 @@ def test_guided_window_tuning_ends_within_half_a_point_of_the_grid_best(scene) -
 
 def test_tune_writes_params_plot_and_json(tmp_path: Path, capsys) -> None:
     out, fig = tmp_path / "p.toml", tmp_path / "fig.png"
-    assert main(["tune", "--iterations", "6", "--windows", "7:15", "--out", str(out),
-                 "--plot", str(fig), "--json"]) == 0
+    assert main(["tune", "--method", "paper", "--iterations", "6", "--windows", "7:15",
+                 "--out", str(out), "--plot", str(fig), "--json"]) == 0
     result = json.loads(capsys.readouterr().out)
     for key in ("method", "space", "best_params", "best_bad", "evaluations", "iterations",
                 "history"):
@@ -60,6 +60,19 @@ def test_tune_writes_params_plot_and_json(tmp_path: Path, capsys) -> None:
     img = cv2.imread(str(fig))
     assert img is not None and img.shape[1] > 800
     assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".")] == []
+
+
+def test_plain_tune_runs_in_the_measured_conditions(tmp_path: Path, capsys) -> None:
+    """The defaults are what docs/tuning.md measured: TPE, clipped borders, the
+    ground-truth range from the nonocc percentiles."""
+    out = tmp_path / "p.toml"
+    assert main(["tune", "--windows", "9:13", "--out", str(out), "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    params, tuning = load_params(out)
+    assert result["method"] == tuning["method"] == "tpe"
+    assert params.border == "clip"
+    assert main(["tune", "--windows", "9:13", "--border", "invalid", "--out", str(out)]) == 0
+    assert load_params(out)[0].border == "invalid"  # what the user names wins
 
 
 def test_tuned_params_round_trip_into_eval(tmp_path: Path, capsys) -> None:
@@ -80,9 +93,9 @@ def _run(*argv: str) -> subprocess.CompletedProcess[str]:
     (["--space", "nope"], "invalid choice"),
     (["--method", "nope"], "invalid choice"),
     (["--iterations", "0"], "at least 1"),
-    (["--space", "sad"], "tunes one parameter"),
+    (["--space", "sad", "--method", "paper"], "tunes one parameter"),
     (["--windows", "4:10"], "odd bounds"),
-    (["--alpha", "0.5"], "belong to --method qlearning"),
+    (["--alpha", "0.5", "--method", "paper"], "belong to --method qlearning"),
     (["--method", "grid", "--gamma", "0.5"], "takes no learning parameters"),
 ])
 def test_bad_input_is_a_one_line_error(argv: list[str], message: str) -> None:

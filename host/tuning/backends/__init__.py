@@ -8,10 +8,15 @@ from typing import Protocol
 
 from host.stereo.params import MatcherParams
 
+__all__ = ["Backend", "Score", "make_backend"]
+
 Score = Callable[[MatcherParams], list[float]]
 
 
 class Backend(Protocol):
+    """Where evaluations run: map scores each parameter set (one score per scene), in order;
+    close releases the workers."""
+
     parallel: int  # how many evaluations it runs at once
 
     def map(self, params: Sequence[MatcherParams]) -> list[list[float]]: ...

@@ -1,9 +1,13 @@
-"""The Ray backend: scores parameter sets as Ray tasks, on a local cluster it starts or on an
-existing one at an address. The score (with its images) goes to the object store once."""
+"""The Ray backend: scores parameter sets as Ray tasks, on a local cluster it starts (bound to
+127.0.0.1, so nothing listens beyond this machine and Ray looks up no outside address for its
+own) or on an existing one at an address, which must answer within seconds. The score (with
+its images) goes to the object store once."""
 
 from __future__ import annotations
 
 import os
+import re
+import socket
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -28,7 +32,9 @@ class RayBackend:
             kw: dict[str, Any] = {"include_dashboard": False, "logging_level": "ERROR",
                                   "log_to_driver": False}
             if address is None:
-                kw["num_cpus"] = os.cpu_count() or 1
+                kw |= {"num_cpus": os.cpu_count() or 1, "_node_ip_address": LOCAL_IP}
+            else:
+                reachable(address)
             _init(ray, address, kw)
         self.parallel = max(1, int(ray.cluster_resources().get("CPU", 1)))
         self._ref = ray.put(score)
@@ -42,6 +48,23 @@ class RayBackend:
     def close(self) -> None:
         if self._started:
             self._ray.shutdown()
+
+
+LOCAL_IP = "127.0.0.1"  # the local cluster's node address (../shared/local-servers.md)
+CONNECT_S = 3.0  # a cluster's head answers a TCP connection at once, or not at all
+
+
+def reachable(address: str, timeout_s: float = CONNECT_S) -> None:
+    """One line, at once, when nothing answers at host:port (or ray://host:port): Ray itself
+    waits minutes for a head that is not there. 'auto' is Ray's own lookup."""
+    m = re.fullmatch(r"(?:ray://)?([\w.\-]+):(\d+)", address)
+    if m is None:
+        return
+    try:
+        socket.create_connection((m[1], int(m[2])), timeout=timeout_s).close()
+    except OSError as e:
+        why = "no answer" if isinstance(e, TimeoutError) else (e.strerror or str(e))
+        raise HostError(f"--ray {address}: no Ray cluster answers there ({why})") from None
 
 
 def _init(ray: Any, address: str | None, kw: dict[str, Any], tries: int = 2) -> None:
