@@ -29,6 +29,7 @@ from host.commands.view import add_view_option, open_view
 from host.errors import HostError, NotReached
 from host.files import check_output
 from host.link.client import RobotLink
+from host.record import add_record_options, check_record, record_servo
 from host.servo.controller import ControlConfig
 from host.servo.loop import Servo
 from host.servo.report import plot_run, write_csv
@@ -89,6 +90,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     add_camera_options(p, sim=True)
     add_matcher_options(p)
     add_view_option(p)
+    add_record_options(p)
     p.set_defaults(run=run)
 
 
@@ -125,6 +127,7 @@ def run(args: argparse.Namespace) -> int:
         check_output(args.log, "csv", "--log")
     if args.plot:
         check_output(args.plot, "png", "--plot")
+    check_record(args)
     if args.min_duty > args.max_duty:
         raise HostError(f"--min-duty {args.min_duty} exceeds --max-duty {args.max_duty}")
     trial_only = [o for o, v in (("--json", args.json), ("--nominal", args.nominal),
@@ -218,7 +221,7 @@ def _avr_board(args):
 
 
 def _servo(args, servo, geometry, world, clock) -> int:
-    with open_view(args.view, servo):
+    with open_view(args.view, servo), record_servo(args, servo, clock):
         return _run_servo(args, servo, geometry, world, clock)
 
 

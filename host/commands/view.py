@@ -13,6 +13,7 @@ from host.camera.calibration import Calibration, Geometry
 from host.camera.open import add_camera_options, open_source, parse_size
 from host.commands.options import POSITIVE, add_matcher_options, params_from_args
 from host.errors import HostError
+from host.record import add_record_options, check_record, recording
 from host.servo.marker import find_marker
 from host.servo.snapshot import Snapshot
 from host.stereo.matcher import compute_disparity
@@ -57,16 +58,25 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--duration", type=POSITIVE, metavar="S", help="stop after S seconds")
     add_camera_options(p)
     add_matcher_options(p)
+    add_record_options(p)
     p.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
     params = params_from_args(args)
+    check_record(args)
     with contextlib.ExitStack() as stack:
         source = stack.enter_context(open_source(args))
         geometry = (Calibration.load(args.calib).geometry if args.calib
                     else Geometry.minoru_default(*parse_size(args.size)))
         view = stack.enter_context(open_view(args.view))
+        observers = [view.feed]
+        rec = stack.enter_context(recording(args, time.monotonic))
+        if rec is not None:
+            from host.record.tap import RecordingSource, StepRecorder, map_range
+
+            source = RecordingSource(source, rec, geometry)
+            observers.append(StepRecorder(rec, source, map_range(params)))
         t0 = time.monotonic()
 
         def time_left() -> bool:
@@ -76,8 +86,10 @@ def run(args: argparse.Namespace) -> int:
         for frame in source:
             disp = compute_disparity(frame.left, frame.right, params)
             last = find_marker(frame.left, frame.right, "disc", None, geometry.baseline_m, last)
-            view.feed(Snapshot(time.monotonic() - t0, "view", "no robot: looking only",
-                               frame.left, disp, 0, None, last, None, None, geometry))
+            snap = Snapshot(time.monotonic() - t0, "view", "no robot: looking only", frame.left,
+                            disp, 0, None, last, None, None, geometry)
+            for observer in observers:
+                observer(snap)
             if not time_left():
                 return 0
         print("host view: the camera ended; the page shows its last frame (Ctrl-C to quit)",
