@@ -10,8 +10,7 @@ import sys
 import time
 from pathlib import Path
 
-from host.camera.calibration import Calibration, Geometry
-from host.camera.open import add_camera_options, open_source, parse_size
+from host.camera.open import add_camera_options, open_source, parse_size, source_geometry
 from host.camera.source import CameraError
 from host.commands.options import (
     COUNT,
@@ -24,9 +23,9 @@ from host.commands.options import (
     int_range,
     params_from_args,
 )
-from host.commands.servo_outcome import outcome
+from host.commands.servo_outcome import outcome, replay_outcome
 from host.commands.view import add_view_option, open_view
-from host.errors import HostError, NotReached
+from host.errors import HostError, NotReached, RecordingEnded
 from host.files import check_output
 from host.link.client import RobotLink
 from host.record import add_record_options, check_record, record_servo
@@ -153,12 +152,12 @@ def run(args: argparse.Namespace) -> int:
         # the port first: a wrong one fails before a camera is opened
         link = stack.enter_context(RobotLink(service.path if service else args.port))
         source = stack.enter_context(open_source(args))
-        geometry = (Calibration.load(args.calib).geometry if args.calib
-                    else Geometry.minoru_default(*parse_size(args.size)))
+        geometry = source_geometry(args, source)
+        clock = getattr(source, "clock", time.monotonic)  # a bag's own clock (its stamps)
         servo = Servo(source, link, params, geometry, _control(args), marker=args.marker,
                       marker_radius_m=args.marker_radius_cm / 100 if args.marker_radius_cm
-                      else None)
-        return _servo(args, servo, geometry, None, time.monotonic)
+                      else None, clock=clock)
+        return _servo(args, servo, geometry, None, clock)
 
 
 def _link_faults(args):
@@ -231,6 +230,7 @@ def _run_servo(args, servo, geometry, world, clock) -> int:
     print(f"target: nearest object at disparity {target.disparity:.2f} px ({z:.3f} m), "
           f"{target.area} px; tolerance {servo.tolerance_m * 100:g} cm", file=sys.stderr)
     status = _Status()
+    ended = False
     t0 = clock()
     try:
         while True:
@@ -239,7 +239,8 @@ def _run_servo(args, servo, geometry, world, clock) -> int:
             except CameraError:
                 if not args.camera.startswith("replay:"):
                     raise
-                break  # the end of a replay ends the run; outcome() tells how it went
+                ended = True
+                break  # the end of a replay ends the run; replay_outcome() tells how
             for note in servo.notes:
                 print(f"note: {note}", file=sys.stderr)
             servo.notes.clear()
@@ -259,12 +260,12 @@ def _run_servo(args, servo, geometry, world, clock) -> int:
                 write_csv(args.log, servo.rows)
             if args.plot:
                 plot_run(args.plot, servo.rows, geometry)
-    failed, msg = outcome(servo)
+    failed, msg = replay_outcome(servo, servo.source) if ended else outcome(servo)
     if world is not None:
         msg += (f"; true robot depth {world.robot.z_m:.3f} m, nearest box "
                 f"{world.nearest_box().z_m:.3f} m")
     if failed:
-        raise NotReached(msg)
+        raise (RecordingEnded if failed == RecordingEnded.status else NotReached)(msg)
     print(msg, file=sys.stderr)
     if servo.requested_stop:
         robot = servo.link.status()

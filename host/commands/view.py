@@ -5,12 +5,12 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import dataclasses
 import sys
 import time
 from collections.abc import Iterator
 
-from host.camera.calibration import Calibration, Geometry
-from host.camera.open import add_camera_options, open_source, parse_size
+from host.camera.open import add_camera_options, open_source, source_geometry
 from host.commands.options import POSITIVE, add_matcher_options, params_from_args
 from host.errors import HostError
 from host.record import add_record_options, check_record, recording
@@ -67,8 +67,7 @@ def run(args: argparse.Namespace) -> int:
     check_record(args)
     with contextlib.ExitStack() as stack:
         source = stack.enter_context(open_source(args))
-        geometry = (Calibration.load(args.calib).geometry if args.calib
-                    else Geometry.minoru_default(*parse_size(args.size)))
+        geometry = source_geometry(args, source)
         view = stack.enter_context(open_view(args.view))
         observers = [view.feed]
         rec = stack.enter_context(recording(args, time.monotonic))
@@ -82,7 +81,7 @@ def run(args: argparse.Namespace) -> int:
         def time_left() -> bool:
             return args.duration is None or time.monotonic() - t0 < args.duration
 
-        last = None
+        last, snap = None, None
         for frame in source:
             disp = compute_disparity(frame.left, frame.right, params)
             last = find_marker(frame.left, frame.right, "disc", None, geometry.baseline_m, last)
@@ -92,7 +91,12 @@ def run(args: argparse.Namespace) -> int:
                 observer(snap)
             if not time_left():
                 return 0
-        print("host view: the camera ended; the page shows its last frame (Ctrl-C to quit)",
+        ended = getattr(source, "ended", None)
+        how = ended() if callable(ended) else "the camera ended"
+        if snap is not None:  # the page says so too, over the last frame
+            view.feed(dataclasses.replace(snap, t=time.monotonic() - t0, phase="ended",
+                                          reason=f"{how}: the last frame is shown"))
+        print(f"host view: {how}; the page shows its last frame (Ctrl-C to quit)",
               file=sys.stderr, flush=True)
         while time_left():
             time.sleep(0.1)

@@ -119,7 +119,7 @@ class Recorder:
                  compression: str = "zstd", queue_items: int = QUEUE_ITEMS,
                  chunk_bytes: int = CHUNK_BYTES) -> None:
         self.path = path
-        self.offset_s = time.time() - clock()
+        self.offset_ns = time.time_ns() - int(round(clock() * 1e9))  # whole ns: t keeps its digits
         self.queued: Counter[str] = Counter()
         self.dropped: Counter[str] = Counter()
         self.written: Counter[str] = Counter()
@@ -134,7 +134,7 @@ class Recorder:
 
     def ns(self, t: float) -> int:
         """A time on the run's clock (s) as ROS time (ns since the epoch)."""
-        return int(round((t + self.offset_s) * 1e9))
+        return int(round(t * 1e9)) + self.offset_ns
 
     def put(self, kind: str, build: Build) -> None:
         """Queue build, or drop it and count the drop when the queue is full."""

@@ -5,7 +5,6 @@ against what the run itself saw."""
 
 from __future__ import annotations
 
-import argparse
 import math
 from pathlib import Path
 
@@ -20,29 +19,8 @@ from mcap_ros2.decoder import DecoderFactory  # noqa: E402
 from rosbags.rosbag2 import Reader  # noqa: E402
 from rosbags.typesys import Stores, get_typestore  # noqa: E402
 
-from host.record import record_servo  # noqa: E402
 from host.record.messages import TOPICS  # noqa: E402
-from host.sim.faults import CameraFaults, WorldFaults  # noqa: E402
-from host.sim.run import Setup, simulation  # noqa: E402
-
-STEPS = 30
-
-
-@pytest.fixture(scope="module")
-def run(tmp_path_factory):
-    """A short simulated run recorded, and what it saw: (raw pair, snapshot) per step."""
-    path = tmp_path_factory.mktemp("rec") / "run.mcap"
-    args = argparse.Namespace(record=path, record_compression="zstd")
-    seen = []
-    faults = WorldFaults(camera=CameraFaults(skew_ms=8.0))  # the right view's stamps differ
-    with simulation(Setup((320, 240), 1.9, faults=faults), reference=False) as sim:
-        with record_servo(args, sim.servo, sim.source.clock) as rec:
-            tap = sim.servo.source
-            sim.servo.observers.append(lambda snap: seen.append((tap.last, snap)))
-            sim.servo.reference()
-            for _ in range(STEPS):
-                sim.step()
-    return path, rec, seen
+from tests.record.conftest import STEPS  # noqa: E402
 
 
 def _rosbags(path: Path) -> dict[str, list]:
@@ -80,7 +58,7 @@ def _pixels(msg) -> np.ndarray:
 
 @pytest.mark.parametrize("read", [_rosbags, _mcap], ids=["rosbags", "mcap"])
 def test_every_topic_decodes_as_the_run_saw_it(run, read):
-    path, rec, seen = run
+    path, rec, seen, _ = run
     topics = read(path)
     pairs = [frame for frame, _ in seen]
     snaps = [snap for _, snap in seen]
@@ -141,7 +119,7 @@ def test_every_topic_decodes_as_the_run_saw_it(run, read):
 
 
 def test_the_recorder_says_what_it_dropped(run):
-    path, rec, _ = run
+    path, rec, _, _ = run
     final = [d for _, d in _mcap(path)["/diagnostics"]
              if any(s.name == "recorder" for s in d.status)][-1]
     status = next(s for s in final.status if s.name == "recorder")
