@@ -24,7 +24,7 @@ from host.commands.options import (
     params_from_args,
 )
 from host.commands.servo_outcome import outcome, replay_outcome
-from host.commands.view import add_view_option, open_view
+from host.commands.view import add_view_option, hold_view, open_view
 from host.errors import HostError, NotReached, RecordingEnded
 from host.files import check_output
 from host.link.client import RobotLink
@@ -88,7 +88,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="sim: the robot goes silent after MS ms")
     add_camera_options(p, sim=True)
     add_matcher_options(p)
-    add_view_option(p)
+    add_view_option(p, servo=True)
     add_record_options(p)
     p.set_defaults(run=run)
 
@@ -198,6 +198,11 @@ def _run_sim(args) -> int:
         setup = Setup(parse_size(args.size), args.start_depth, faults=faults, seed=args.seed,
                       fps=args.fps, params=params, control=_control(args), board=board)
         sim = stack.enter_context(simulation(setup, reference=False))
+        speed = args.speed if args.speed is not None else 1.0 if args.view else 0.0
+        if speed > 0:  # to be watched: in real time (or --speed times it)
+            from host.camera.paced import PacedSource
+
+            sim.servo.source = PacedSource(sim.servo.source, speed)
         return _servo(args, sim.servo, sim.servo.geometry, sim.world, sim.source.clock)
 
 
@@ -220,8 +225,19 @@ def _avr_board(args):
 
 
 def _servo(args, servo, geometry, world, clock) -> int:
-    with open_view(args.view, servo), record_servo(args, servo, clock):
-        return _run_servo(args, servo, geometry, world, clock)
+    with open_view(args.view, servo, args.view_wait) as view:
+        # a simulated run's page stays up after the run has ended (not when its STOP ended it)
+        hold = view is not None and world is not None
+        try:
+            with record_servo(args, servo, clock):
+                status = _run_servo(args, servo, geometry, world, clock)
+        except NotReached as e:
+            if hold and not servo.requested_stop:
+                hold_view(view, str(e))
+            raise
+        if hold and not servo.requested_stop:
+            hold_view(view, outcome(servo)[1])
+        return status
 
 
 def _run_servo(args, servo, geometry, world, clock) -> int:

@@ -19,17 +19,44 @@ from host.servo.snapshot import Snapshot
 from host.stereo.matcher import compute_disparity
 
 
-def add_view_option(p: argparse.ArgumentParser, default: str | None = None) -> None:
+def add_view_option(p: argparse.ArgumentParser, default: str | None = None,
+                    servo: bool = False) -> None:
     p.add_argument("--view", nargs="?", const="127.0.0.1:0", default=default,
                    metavar="[HOST:]PORT",
                    help="serve a live view on this address (default 127.0.0.1 and a free port; "
-                        "another address than loopback needs the token printed at start)")
+                        "another address than loopback needs the token printed at start)"
+                        + ("; with --sim the simulation then runs in real time (--speed) and "
+                           "the page stays up after the run until Ctrl-C" if servo else ""))
+    p.add_argument("--view-wait", action="store_true",
+                   help="--view: start only once a page is open (so none of the run is missed)")
+
+
+def wait_for_page(server, poll_s: float = 0.05) -> None:
+    """Until a page has connected to server (Ctrl-C ends the wait, and the command)."""
+    print("live view: waiting for a page to open (--view-wait; Ctrl-C to quit)",
+          file=sys.stderr, flush=True)
+    while not server.connections:
+        time.sleep(poll_s)
+
+
+def hold_view(server, reason: str) -> None:
+    """After the run: the page says it has ended (reason) and stays up until Ctrl-C, which
+    then ends the command as the run did (not as an interrupt)."""
+    server.feed.end(reason)
+    print("live view: the run has ended; the page stays up until Ctrl-C", file=sys.stderr,
+          flush=True)
+    try:
+        while True:
+            time.sleep(0.2)
+    except KeyboardInterrupt:
+        print("", file=sys.stderr)
 
 
 @contextlib.contextmanager
-def open_view(address: str | None, servo=None) -> Iterator[object | None]:
+def open_view(address: str | None, servo=None, wait: bool = False) -> Iterator[object | None]:
     """The live view on address ([HOST:]PORT), fed by servo's steps, its STOP button stopping
-    servo (no servo: no STOP); nothing when address is None. Prints the page's address."""
+    servo (no servo: no STOP); nothing when address is None. Prints the page's address; with
+    wait, returns once a page has connected."""
     if address is None:
         yield None
         return
@@ -47,6 +74,8 @@ def open_view(address: str | None, servo=None) -> Iterator[object | None]:
                 servo.observers.append(feed)
             note = "" if server.token is None else " (the token is needed: keep it private)"
             print(f"live view: {server.url}{note}", file=sys.stderr, flush=True)
+            if wait:
+                wait_for_page(server)
             yield server
     finally:
         feed.close()
@@ -68,7 +97,7 @@ def run(args: argparse.Namespace) -> int:
     with contextlib.ExitStack() as stack:
         source = stack.enter_context(open_source(args))
         geometry = source_geometry(args, source)
-        view = stack.enter_context(open_view(args.view))
+        view = stack.enter_context(open_view(args.view, wait=args.view_wait))
         observers = [view.feed]
         rec = stack.enter_context(recording(args, time.monotonic))
         if rec is not None:

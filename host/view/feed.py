@@ -8,6 +8,7 @@ and counted; the loop never waits for the view.
 from __future__ import annotations
 
 import bisect
+import dataclasses
 import math
 import threading
 import time
@@ -124,6 +125,14 @@ class ViewFeed:
                 return self._update if self._update and self._update.seq > after else None
             finally:
                 self._waiting -= 1
+
+    def end(self, reason: str) -> None:
+        """The run is over: the last picture again, its phase "ended" with reason (the page
+        says so while it stays up)."""
+        with self._cond:
+            snap = self._latest
+        if snap is not None:
+            self(dataclasses.replace(snap, phase="ended", reason=reason))
 
     @property
     def latest_seq(self) -> int:
