@@ -56,6 +56,7 @@ bench: venv
 	$(BIN)/python bench/link.py
 	$(BIN)/python bench/servo.py
 	$(BIN)/python bench/view.py
+	$(BIN)/python bench/record.py
 	$(MAKE) mutants
 
 # firmware mutation testing (firmware/atmega328/mutants.toml): every mutant must be killed; it

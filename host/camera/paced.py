@@ -14,12 +14,14 @@ LATE_S = 0.1  # a pair this much behind its pace restarts the pace from it
 
 
 class PacedSource(StereoSource):
-    """inner at speed times real time (speed > 0); inner rectifies as it did."""
+    """inner at speed times real time (speed > 0); inner rectifies as it did. catch_up: a
+    late pair does not restart the pace, the pairs after it come at once until the pace is
+    kept again (as a camera's frames wait for a slow loop)."""
 
-    def __init__(self, inner: StereoSource, speed: float = 1.0) -> None:
+    def __init__(self, inner: StereoSource, speed: float = 1.0, catch_up: bool = False) -> None:
         if speed <= 0:
             raise ValueError("a paced source needs a speed above 0")
-        self.inner, self.speed = inner, speed
+        self.inner, self.speed, self.catch_up = inner, speed, catch_up
         self._t0: tuple[float, float] | None = None  # (first capture, wall time then)
         self.late = 0  # pairs handed on later than their pace (the loop was slower)
 
@@ -36,9 +38,10 @@ class PacedSource(StereoSource):
         due = self._t0[1] + (frame.t_left - self._t0[0]) / self.speed
         if due > now:
             time.sleep(due - now)
-        elif now - due > LATE_S:  # behind (a slow step): go on from here, never rush to catch up
+        elif now - due > LATE_S:  # behind (a slow step): go on from here, or catch up
             self.late += 1
-            self._t0 = (frame.t_left, now)
+            if not self.catch_up:
+                self._t0 = (frame.t_left, now)
         return frame
 
     def describe(self) -> dict:

@@ -167,3 +167,32 @@ def test_a_killed_run_leaves_a_file_that_opens_to_its_last_chunk(tmp_path):
             ended = True  # the chunk being filled when the run was killed
     assert images >= 12  # three chunks of 4 MB hold at least this many pairs
     assert ended  # cut off where the run was killed, not closed
+
+
+def test_a_recorder_that_falls_behind_drops_counts_and_says_so(tmp_path):
+    """The loop never waits: with the queue full, items are dropped, counted, and the file's
+    diagnostics say how many."""
+    import threading
+
+    from host.record import messages as m
+    from host.record.writer import Recorder
+
+    gate = threading.Event()
+    rec = Recorder(tmp_path / "slow.mcap", queue_items=2)
+    img = np.zeros((4, 4), np.uint8)
+
+    def build(i=0):
+        gate.wait(10)  # the worker is stuck on the first item meanwhile
+        return [("/stereo/left/image_raw", m.image(img, 1000 + i, m.LEFT_FRAME), 1000 + i)]
+
+    for i in range(10):
+        rec.put("frame", lambda i=i: build(i))  # returns at once, full queue or not
+    gate.set()
+    rec.close()
+    assert sum(rec.dropped.values()) == 10 - rec.queued["frame"] > 0
+    topics = _mcap(tmp_path / "slow.mcap")
+    assert len(topics["/stereo/left/image_raw"]) == rec.queued["frame"]
+    final = topics["/diagnostics"][-1][1].status[0]
+    values = {v.key: v.value for v in final.values}
+    assert final.level == m.WARN and final.message.startswith(f"{rec.dropped['frame']} items")
+    assert values["frame dropped"] == str(rec.dropped["frame"])
