@@ -127,6 +127,10 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         check_output(args.plot, "png", "--plot")
     check_record(args)
+    if args.record and args.trials:
+        raise HostError("--record records one run: not with --trials")
+    if args.view_wait and not args.view:
+        raise HostError("--view-wait waits for the page of --view: give --view too")
     if args.min_duty > args.max_duty:
         raise HostError(f"--min-duty {args.min_duty} exceeds --max-duty {args.max_duty}")
     trial_only = [o for o, v in (("--json", args.json), ("--nominal", args.nominal),

@@ -88,3 +88,16 @@ def test_an_existing_recording_is_never_overwritten(tmp_path: Path) -> None:
     assert r.stderr.count("\n") == 1 and rec.read_bytes() == b"the user's"
     r = _host("servo", "--sim", "--record", str(tmp_path / "run.bag"))
     assert r.returncode == 2 and "name it .mcap" in r.stderr
+
+
+def test_options_that_cannot_go_together_are_one_line(tmp_path: Path) -> None:
+    missing = tmp_path / "none.mcap"
+    for args, words in (
+            (["--sim", "--trials", "2", "--record", str(tmp_path / "t.mcap")],
+             "not with --trials"),
+            (["--sim", "--view-wait"], "give --view too"),
+            (["--camera", f"replay:{missing}", "--port", "emulator"], "no such recording")):
+        r = _host("servo", *args)
+        assert r.returncode == 2 and words in r.stderr, r.stderr
+        assert r.stderr.count("\n") == 1
+    assert not (tmp_path / "t.mcap").exists()
