@@ -14,7 +14,7 @@ export STEREO_SERVO_DATA ?= $(if $(wildcard $(DATA)/middlebury/index.json),$(DAT
 
 $(BIN)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/pip install --quiet --disable-pip-version-check -e '.[test,tpe,ray]'
+	$(BIN)/pip install --quiet --disable-pip-version-check -e '.[test,ray]'
 	$(BIN)/python -m host.stereo.warm  # numba compiles now, not in the user's first run
 	touch $@
 
@@ -58,6 +58,7 @@ bench: venv
 	$(BIN)/python bench/view.py
 	$(BIN)/python bench/trials.py
 	$(MAKE) fuzz
+	$(BIN)/python bench/record.py
 	$(MAKE) mutants
 
 # firmware mutation testing (firmware/atmega328/mutants.toml): an unmutated control must pass,

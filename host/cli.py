@@ -37,7 +37,8 @@ EXAMPLES = {
 EPILOGS = {
     "servo": "exit status: 0 held at the target (or stopped by --duration); 2 bad input or a "
              "link failure;\n3 not reached: the marker was never seen, or the run ended in a "
-             "safe stop;\n128+n ended by signal n (Ctrl-C, SIGTERM, SIGHUP): STOP is sent and "
+             "safe stop;\n4 a replay (--camera replay:...) ran out before the robot held at "
+             "the target;\n128+n ended by signal n (Ctrl-C, SIGTERM, SIGHUP): STOP is sent and "
              "the log and plot are kept.",
 }
 

@@ -18,6 +18,12 @@ class NotReached(HostError):
     status = 3
 
 
+class RecordingEnded(NotReached):
+    """A replay ran out before the robot held at the target."""
+
+    status = 4
+
+
 class Interrupted(KeyboardInterrupt):
     """A signal that ends a command like Ctrl-C does (SIGTERM, SIGHUP); exit status 128+n."""
 

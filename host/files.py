@@ -28,9 +28,10 @@ from host.errors import HostError
 # kinds of output: what the bytes are, and the file name endings that say so
 IMAGE = "image"  # any format OpenCV can encode, told by the extension
 KINDS = {"png": (".png",), "npy": (".npy",), "toml": (".toml",), "csv": (".csv",),
-         "yml": (".yml", ".yaml")}
+         "yml": (".yml", ".yaml"), "mcap": (".mcap",)}
 _KIND_NAMES = {"png": "a PNG picture", "npy": "a NumPy array", "toml": "a TOML file",
-               "csv": "a CSV table", "yml": "an OpenCV YAML file"}
+               "csv": "a CSV table", "yml": "an OpenCV YAML file",
+               "mcap": "a ROS 2 bag in MCAP storage"}
 
 _staged: contextvars.ContextVar[dict[Path, bytes] | None] = contextvars.ContextVar(
     "host_files_staged", default=None)

@@ -17,7 +17,7 @@ import cv2
 import numpy as np
 import yaml
 
-from host.camera.calibration import MATRICES, Calibration
+from host.camera.calibration import MATRICES, Calibration, Geometry
 from host.camera.source import CameraError
 from host.files import write_text_atomic
 
@@ -142,21 +142,50 @@ def _ros_matrix(m: np.ndarray) -> str:
     return f"\n  rows: {rows}\n  cols: {cols}\n  data: [{data}]"
 
 
-def ros_text(calib: Calibration, side: str) -> str:
-    """One camera's camera_info YAML (side: left or right)."""
+def camera_info(calib: Calibration, side: str) -> dict:
+    """One camera's camera_info fields (side: left or right): width, height, distortion_model
+    and K, D, R, P as arrays, P's Tx in metres as ROS has it. The one source of both the --ros
+    files and the recordings' sensor_msgs/CameraInfo."""
     i = "1" if side == "left" else "2"
     m = calib.mats
-    p = m["P" + i].copy()
+    p = np.asarray(m["P" + i], np.float64).copy()
     p[:, 3] /= MM_PER_M  # ROS: Tx = -fx' * baseline in metres
-    d = m["D" + i].reshape(1, -1)
-    model = "plumb_bob" if d.size <= 5 else "rational_polynomial"
-    return (f"image_width: {calib.size[0]}\nimage_height: {calib.size[1]}\n"
+    d = np.asarray(m["D" + i], np.float64).reshape(1, -1)
+    return {"width": calib.size[0], "height": calib.size[1],
+            "distortion_model": "plumb_bob" if d.size <= 5 else "rational_polynomial",
+            "K": np.asarray(m["M" + i], np.float64), "D": d,
+            "R": np.asarray(m["R" + i], np.float64), "P": p}
+
+
+def ros_text(calib: Calibration, side: str) -> str:
+    """One camera's camera_info YAML (side: left or right)."""
+    info = camera_info(calib, side)
+    return (f"image_width: {info['width']}\nimage_height: {info['height']}\n"
             f"camera_name: {side}\n"
-            f"camera_matrix:{_ros_matrix(m['M' + i])}\n"
-            f"distortion_model: {model}\n"
-            f"distortion_coefficients:{_ros_matrix(d)}\n"
-            f"rectification_matrix:{_ros_matrix(m['R' + i])}\n"
-            f"projection_matrix:{_ros_matrix(p)}\n")
+            f"camera_matrix:{_ros_matrix(info['K'])}\n"
+            f"distortion_model: {info['distortion_model']}\n"
+            f"distortion_coefficients:{_ros_matrix(info['D'])}\n"
+            f"rectification_matrix:{_ros_matrix(info['R'])}\n"
+            f"projection_matrix:{_ros_matrix(info['P'])}\n")
+
+
+def ideal_calibration(geometry: Geometry, size: tuple[int, int]) -> Calibration:
+    """The calibration of an already rectified pair of the given geometry (no distortion, no
+    rotation): what a recording's CameraInfo says when no --calib was given."""
+    f = geometry.focal_px
+    k = np.array([[f, 0, geometry.cx], [0, f, geometry.cy], [0, 0, 1]], np.float64)
+    p1 = np.hstack([k, np.zeros((3, 1))])
+    p2 = p1.copy()
+    p2[0, 3] = -f * geometry.baseline_m
+    left = {"K": k, "D": np.zeros((1, 5)), "R": np.eye(3), "P": p1}
+    return from_camera_info(size, left, {**left, "P": p2})
+
+
+def is_ideal(calib: Calibration) -> bool:
+    """Whether rectifying with calib changes nothing (no distortion, no rotation, P = K)."""
+    m = calib.mats
+    return all(not np.any(m["D" + i]) and np.allclose(m["R" + i], np.eye(3))
+               and np.allclose(m["P" + i][:, :3], m["M" + i]) for i in "12")
 
 
 def save_ros(calib: Calibration, folder: Path) -> tuple[Path, Path]:
@@ -216,18 +245,26 @@ def _read_ros(path: str) -> tuple[tuple[int, int], dict[str, np.ndarray]]:
 
 
 def load_ros(left_path: str, right_path: str) -> Calibration:
-    """A stereo calibration from the left and right camera_info files: the rectification is
-    theirs; R, T, E, F and Q are rebuilt from it (R = R2^T R1, T = R2^T t, t the rectified
-    right camera's offset)."""
+    """A stereo calibration from the left and right camera_info files (from_camera_info)."""
     (size, left), (size_r, right) = _read_ros(left_path), _read_ros(right_path)
     if size != size_r:
         raise CameraError(f"{left_path} is for {size[0]}x{size[1]}, {right_path} for "
                           f"{size_r[0]}x{size_r[1]}")
-    p1, p2 = left["P"].copy(), right["P"].copy()
+    return from_camera_info(size, left, right, right_path)
+
+
+def from_camera_info(size: tuple[int, int], left: dict, right: dict,
+                     right_name: str = "the right camera_info") -> Calibration:
+    """A stereo calibration from the two cameras' K (or M), D, R, P (Tx in metres): the
+    rectification is theirs; R, T, E, F and Q are rebuilt from it (R = R2^T R1, T = R2^T t,
+    t the rectified right camera's offset)."""
+    left = {"M": left.get("M", left.get("K")), **left}
+    right = {"M": right.get("M", right.get("K")), **right}
+    p1, p2 = np.array(left["P"], np.float64), np.array(right["P"], np.float64)
     p1[:, 3] *= MM_PER_M
     p2[:, 3] *= MM_PER_M
     if p2[0, 3] == 0:
-        raise CameraError(f"{right_path}: projection_matrix has no baseline (Tx = 0): is it "
+        raise CameraError(f"{right_name}: projection_matrix has no baseline (Tx = 0): is it "
                           f"the right camera's?")
     tx, ty = p2[0, 3] / p2[0, 0], p2[1, 3] / p2[1, 1]
     r = right["R"].T @ left["R"]
@@ -235,9 +272,10 @@ def load_ros(left_path: str, right_path: str) -> Calibration:
     tx_hat = np.array([[0, -t[2, 0], t[1, 0]], [t[2, 0], 0, -t[0, 0]], [-t[1, 0], t[0, 0], 0]])
     e = tx_hat @ r
     f = np.linalg.inv(right["M"]).T @ e @ np.linalg.inv(left["M"])
+    f = f / (f[2, 2] if f[2, 2] else np.abs(f).max())  # F[2, 2] is 0 for a rectified pair
     q = np.array([[1, 0, 0, -p1[0, 2]], [0, 1, 0, -p1[1, 2]], [0, 0, 0, p1[0, 0]],
                   [0, 0, -1 / tx, (p1[0, 2] - p2[0, 2]) / tx]])
     mats = {"M1": left["M"], "D1": left["D"], "M2": right["M"], "D2": right["D"], "R": r,
-            "T": t, "E": e, "F": f / f[2, 2], "R1": left["R"], "R2": right["R"], "P1": p1,
+            "T": t, "E": e, "F": f, "R1": left["R"], "R2": right["R"], "P1": p1,
             "P2": p2, "Q": q}
     return Calibration(size, mats, math.nan, math.nan)

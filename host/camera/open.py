@@ -7,7 +7,9 @@ import argparse
 import sys
 from pathlib import Path
 
-from host.camera.calibration import Calibration, Rectifier
+from host.camera.bag import BagSource, is_bag
+from host.camera.calib_files import is_ideal
+from host.camera.calibration import Calibration, Geometry, Rectifier
 from host.camera.live import LiveSource
 from host.camera.lr_check import CHECKS, handedness
 from host.camera.minoru import MinoruSource
@@ -39,7 +41,23 @@ def add_camera_options(p: argparse.ArgumentParser, sim: bool = False) -> None:
                    help="leave exposure, gain and white balance on auto")
     g.add_argument("--calib", metavar="CALIB.yml",
                    help="rectify with this calibration (host calibrate --out), or "
-                        "LEFT.yaml,RIGHT.yaml (ROS camera_info)")
+                        "LEFT.yaml,RIGHT.yaml (ROS camera_info); a replay:FILE.mcap without "
+                        "it is rectified with the bag's CameraInfo")
+    g.add_argument("--speed", type=_speed, metavar="X",
+                   help="replay:FILE.mcap" + (" and --sim" if sim else "") + ": X times the "
+                        "recorded (real) time, 0 as fast as it goes (default: the recorded "
+                        "pace" + ("; --sim runs as fast as it goes unless --view" if sim
+                                  else "") + ")")
+
+
+def _speed(text: str) -> float:
+    try:
+        x = float(text)
+    except ValueError:
+        x = -1.0
+    if not (x >= 0 and x < float("inf")):
+        raise argparse.ArgumentTypeError(f"must be a number >= 0, got {text!r}")
+    return x
 
 
 def parse_size(text: str) -> tuple[int, int]:
@@ -92,16 +110,24 @@ def check_left_right(source: LiveSource, policy: str, frames: int = 3) -> str:
                       f"swap them at start")
 
 
-def open_source(args: argparse.Namespace) -> StereoSource:
-    """The source args.camera names (not sim), with rectification when --calib is given."""
+def open_source(args: argparse.Namespace, speed: float = 1.0) -> StereoSource:
+    """The source args.camera names (not sim), with rectification when --calib is given (or
+    a bag's CameraInfo is not the identity); a bag at args.speed, else speed."""
     spec = args.camera
     rectify = Rectifier(Calibration.load(args.calib)) if args.calib else None  # before a camera
-    if spec.startswith("replay:"):
-        source: StereoSource = ReplaySource(Path(spec[len("replay:"):]))
+    if spec.startswith("replay:") and is_bag(Path(spec[len("replay:"):])):
+        speed = speed if getattr(args, "speed", None) is None else args.speed
+        source: StereoSource = BagSource(Path(spec[len("replay:"):]), speed)
+        calib = source.calibration  # type: ignore[attr-defined]
+        if rectify is None and calib is not None and not is_ideal(calib):
+            rectify = Rectifier(calib)
+    elif spec.startswith("replay:"):
+        source = ReplaySource(Path(spec[len("replay:"):]))
     elif spec.split(":")[0] in ("minoru", "sbs"):
         source = _live(args)
     else:
-        raise HostError(f"unknown camera {spec!r} (minoru, sbs or replay:DIR)")
+        raise HostError(f"unknown camera {spec!r} (minoru, sbs, replay:DIR or "
+                        f"replay:FILE.mcap)")
     source.rectify = rectify
     try:
         if isinstance(source, LiveSource) and args.swap_check != "off":
@@ -110,3 +136,17 @@ def open_source(args: argparse.Namespace) -> StereoSource:
         source.close()
         raise
     return source
+
+
+def known_geometry(args: argparse.Namespace, source: StereoSource | None = None
+                   ) -> Geometry | None:
+    """The rectified geometry from --calib, else from the bag's CameraInfo; None if neither."""
+    if args.calib:
+        return Calibration.load(args.calib).geometry
+    calib = getattr(source, "calibration", None)
+    return calib.geometry if calib is not None else None
+
+
+def source_geometry(args: argparse.Namespace, source: StereoSource | None = None) -> Geometry:
+    """known_geometry, else the Minoru's nominal one at --size (said on stderr)."""
+    return known_geometry(args, source) or Geometry.minoru_default(*parse_size(args.size))

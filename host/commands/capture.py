@@ -12,6 +12,7 @@ from host.camera.open import add_camera_options, open_source
 from host.commands.options import COUNT, NON_NEGATIVE
 from host.errors import HostError
 from host.files import check_folder, write_image_atomic
+from host.record import add_record_options, check_record, recording
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -22,6 +23,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", type=Path, required=True,
                    help="folder for left_NNN/right_NNN.png and manifest.json")
     add_camera_options(p)
+    add_record_options(p)
     p.set_defaults(run=run)
 
 
@@ -33,7 +35,16 @@ def run(args: argparse.Namespace) -> int:
     # writable now, but made only once the camera delivers (nothing left behind on failure)
     existing = next(p for p in (args.out, *args.out.parents) if p.exists())
     check_folder(existing, "--out", target=args.out)
-    with open_source(args) as source:
+    check_record(args)
+    with open_source(args) as source, recording(args, time.monotonic) as rec:
+        if rec is not None:  # every pair the camera delivers, not only those saved
+            from host.camera.calibration import Calibration, Geometry
+            from host.camera.open import parse_size
+            from host.record.tap import RecordingSource
+
+            geometry = (Calibration.load(args.calib).geometry if args.calib
+                        else Geometry.minoru_default(*parse_size(args.size)))
+            source = RecordingSource(source, rec, geometry)
         camera = {**source.describe(), "calib": args.calib}
         pairs: list[dict] = []
         next_t = time.monotonic()

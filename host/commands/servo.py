@@ -11,8 +11,7 @@ import sys
 import time
 from pathlib import Path
 
-from host.camera.calibration import Calibration, Geometry
-from host.camera.open import add_camera_options, open_source, parse_size
+from host.camera.open import add_camera_options, open_source, parse_size, source_geometry
 from host.commands.options import (
     COUNT,
     FRACTION,
@@ -24,15 +23,16 @@ from host.commands.options import (
     int_range,
     params_from_args,
 )
-from host.commands.servo_outcome import outcome
-from host.commands.view import add_view_option, open_view
-from host.errors import HostError, NotReached
+from host.commands.servo_outcome import outcome, replay_outcome
+from host.commands.view import add_view_option, hold_view, open_view
+from host.errors import HostError, NotReached, RecordingEnded
 from host.files import check_folder, check_output
 from host.link.client import RobotLink
+from host.record import add_record_options, check_record, record_servo
 from host.servo.controller import ControlConfig
 from host.servo.loop import Servo
 from host.servo.report import plot_run, write_csv
-from host.servo_run import NOT_SETTLED, Rules, run_servo
+from host.servo_run import ENDED, NOT_SETTLED, Rules, run_servo
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -83,7 +83,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="sim: the robot goes silent after MS ms")
     add_camera_options(p, sim=True)
     add_matcher_options(p)
-    add_view_option(p)
+    add_view_option(p, servo=True)
+    add_record_options(p)
     p.set_defaults(run=run)
 
 
@@ -143,6 +144,11 @@ def run(args: argparse.Namespace) -> int:
         check_output(args.log, "csv", "--log")
     if args.plot:
         check_output(args.plot, "png", "--plot")
+    check_record(args)
+    if args.record and args.trials:
+        raise HostError("--record records one run: not with --trials")
+    if args.view_wait and not args.view:
+        raise HostError("--view-wait waits for the page of --view: give --view too")
     if args.min_duty > args.max_duty:
         raise HostError(f"--min-duty {args.min_duty} exceeds --max-duty {args.max_duty}")
     trial_only = ["--" + o.replace("_", "-") for o in TRIAL_OPTIONS if getattr(args, o)]
@@ -169,12 +175,12 @@ def run(args: argparse.Namespace) -> int:
         # the port first: a wrong one fails before a camera is opened
         link = stack.enter_context(RobotLink(service.path if service else args.port))
         source = stack.enter_context(open_source(args))
-        geometry = (Calibration.load(args.calib).geometry if args.calib
-                    else Geometry.minoru_default(*parse_size(args.size)))
+        geometry = source_geometry(args, source)
+        clock = getattr(source, "clock", time.monotonic)  # a bag's own clock (its stamps)
         servo = Servo(source, link, params, geometry, _control(args), marker=args.marker,
                       marker_radius_m=args.marker_radius_cm / 100 if args.marker_radius_cm
-                      else None)
-        return _servo(args, servo, geometry, None, time.monotonic)
+                      else None, clock=clock)
+        return _servo(args, servo, geometry, None, clock)
 
 
 def _check_trial_args(args) -> None:
@@ -232,6 +238,11 @@ def _run_sim(args) -> int:
         setup = Setup(parse_size(args.size), args.start_depth, faults=faults, seed=args.seed,
                       fps=args.fps, params=params, control=_control(args), board=board)
         sim = stack.enter_context(simulation(setup, reference=False))
+        speed = args.speed if args.speed is not None else 1.0 if args.view else 0.0
+        if speed > 0:  # to be watched: in real time (or --speed times it)
+            from host.camera.paced import PacedSource
+
+            sim.servo.source = PacedSource(sim.servo.source, speed)
         return _servo(args, sim.servo, sim.servo.geometry, sim.world, sim.source.clock)
 
 
@@ -254,8 +265,19 @@ def _avr_board(args):
 
 
 def _servo(args, servo, geometry, world, clock) -> int:
-    with open_view(args.view, servo):
-        return _run_servo(args, servo, geometry, world, clock)
+    with open_view(args.view, servo, args.view_wait) as view:
+        # a simulated run's page stays up after the run has ended (not when its STOP ended it)
+        hold = view is not None and world is not None
+        try:
+            with record_servo(args, servo, clock):
+                status = _run_servo(args, servo, geometry, world, clock)
+        except NotReached as e:
+            if hold and not servo.requested_stop:
+                hold_view(view, str(e))
+            raise
+        if hold and not servo.requested_stop:
+            hold_view(view, outcome(servo)[1])
+        return status
 
 
 SIM_LIMIT_S = 60.0  # a simulated run without --duration that has not settled by then failed
@@ -292,12 +314,13 @@ def _run_servo(args, servo, geometry, world, clock) -> int:
                 write_csv(args.log, servo.rows)
             if args.plot:
                 plot_run(args.plot, servo.rows, geometry)
-    failed, msg = outcome(servo)
+    ended = end.how == ENDED
+    failed, msg = replay_outcome(servo, servo.source) if ended else outcome(servo)
     if world is not None:
         msg += (f"; true robot depth {world.robot.z_m:.3f} m, nearest box "
                 f"{world.nearest_box().z_m:.3f} m")
     if failed:
-        raise NotReached(msg)
+        raise (RecordingEnded if failed == RecordingEnded.status else NotReached)(msg)
     print(msg, file=sys.stderr)
     if servo.requested_stop:
         robot = servo.link.status()

@@ -1,16 +1,17 @@
 """How a servo run ended, as the exit status and one line: held at the target (0), stopped by
-the user (the view's STOP), --duration or a replay's end (0), or not reached (NOT_REACHED): the
-marker was never seen, or the run ended in a safe stop (marker lost, frames too late, target
-vanished)."""
+the user (the view's STOP) or --duration (0), a replay that ran out first (RECORDING_ENDED), or
+not reached (NOT_REACHED): the marker was never seen, or the run ended in a safe stop (marker
+lost, frames too late, target vanished)."""
 
 from __future__ import annotations
 
 import math
 
-from host.errors import NotReached
+from host.errors import NotReached, RecordingEnded
 from host.servo.loop import Servo
 
 NOT_REACHED = NotReached.status  # the run ended without the robot holding at the target
+RECORDING_ENDED = RecordingEnded.status  # the replay ran out before the robot held
 
 
 def outcome(servo: Servo) -> tuple[int, str]:
@@ -37,3 +38,18 @@ def outcome(servo: Servo) -> tuple[int, str]:
     where = (f"{last.depth_m:.3f} m" if math.isfinite(last.depth_m)
              else f"last seen at {seen[-1].depth_m:.3f} m")
     return 0, f"stopped while in phase {last.phase} at {where}, against {target} {after}"
+
+
+def replay_outcome(servo: Servo, source: object) -> tuple[int, str]:
+    """(exit status, message) for a run whose replay ran out: what outcome() says when the run
+    had ended otherwise (held at its last pair, STOP, a safe stop, never seen), else
+    RECORDING_ENDED with where the run was; a bag cut off (a killed recording) is said too."""
+    status, msg = outcome(servo)
+    ended = getattr(source, "ended", None)
+    how = ended() if callable(ended) else "the recording ended"
+    rows = servo.rows
+    if status != 0 or servo.requested_stop or servo.outcome()[0] == "held":
+        return status, msg + (f"; {how}" if getattr(source, "truncated", False) else "")
+    last = rows[-1]
+    return RECORDING_ENDED, (f"{how} in phase {last.phase} after {last.t - rows[0].t:.1f} s, "
+                             f"before the robot held at the target's {servo.target_m:.3f} m")

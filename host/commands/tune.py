@@ -11,7 +11,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from host.camera.open import add_camera_options, open_source, parse_size
+from host.camera.open import add_camera_options, known_geometry, open_source, parse_size
 from host.commands.options import (
     COUNT,
     FRACTION,
@@ -153,12 +153,10 @@ def _camera_scenes(args: argparse.Namespace) -> tuple[list[Scene], float | None]
     if args.camera == "sim":
         pairs, focal_baseline = sim_pairs(*parse_size(args.size), args.frames)
     else:
-        with open_source(args) as source:
+        with open_source(args, speed=0) as source:  # a bag as fast as it reads
             pairs = spread_pairs(source, args.frames, live=args.camera == "minoru")
-        if args.calib:
-            from host.camera.calibration import Calibration
-
-            g = Calibration.load(args.calib).geometry
+        g = known_geometry(args, source)  # --calib, or a bag's CameraInfo
+        if g is not None:
             focal_baseline = g.focal_px * g.baseline_m
     return [Scene(f"{args.camera.split(':')[0]}-{i}", left, match_exposure(left, right))
             for i, (left, right) in enumerate(pairs)], focal_baseline

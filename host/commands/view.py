@@ -5,30 +5,58 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import dataclasses
 import sys
 import time
 from collections.abc import Iterator
 
-from host.camera.calibration import Calibration, Geometry
-from host.camera.open import add_camera_options, open_source, parse_size
+from host.camera.open import add_camera_options, open_source, source_geometry
 from host.commands.options import POSITIVE, add_matcher_options, params_from_args
 from host.errors import HostError
+from host.record import add_record_options, check_record, recording
 from host.servo.marker import find_marker
 from host.servo.snapshot import Snapshot
 from host.stereo.matcher import compute_disparity
 
 
-def add_view_option(p: argparse.ArgumentParser, default: str | None = None) -> None:
+def add_view_option(p: argparse.ArgumentParser, default: str | None = None,
+                    servo: bool = False) -> None:
     p.add_argument("--view", nargs="?", const="127.0.0.1:0", default=default,
                    metavar="[HOST:]PORT",
                    help="serve a live view on this address (default 127.0.0.1 and a free port; "
-                        "another address than loopback needs the token printed at start)")
+                        "another address than loopback needs the token printed at start)"
+                        + ("; with --sim the simulation then runs in real time (--speed) and "
+                           "the page stays up after the run until Ctrl-C" if servo else ""))
+    p.add_argument("--view-wait", action="store_true",
+                   help="--view: start only once a page is open (so none of the run is missed)")
+
+
+def wait_for_page(server, poll_s: float = 0.05) -> None:
+    """Until a page has connected to server (Ctrl-C ends the wait, and the command)."""
+    print("live view: waiting for a page to open (--view-wait; Ctrl-C to quit)",
+          file=sys.stderr, flush=True)
+    while not server.connections:
+        time.sleep(poll_s)
+
+
+def hold_view(server, reason: str) -> None:
+    """After the run: the page says it has ended (reason) and stays up until Ctrl-C, which
+    then ends the command as the run did (not as an interrupt)."""
+    server.feed.end(reason)
+    print("live view: the run has ended; the page stays up until Ctrl-C", file=sys.stderr,
+          flush=True)
+    try:
+        while True:
+            time.sleep(0.2)
+    except KeyboardInterrupt:
+        print("", file=sys.stderr)
 
 
 @contextlib.contextmanager
-def open_view(address: str | None, servo=None) -> Iterator[object | None]:
+def open_view(address: str | None, servo=None, wait: bool = False) -> Iterator[object | None]:
     """The live view on address ([HOST:]PORT), fed by servo's steps, its STOP button stopping
-    servo (no servo: no STOP); nothing when address is None. Prints the page's address."""
+    servo (no servo: no STOP); nothing when address is None. Prints the page's address; with
+    wait, returns once a page has connected."""
     if address is None:
         yield None
         return
@@ -46,6 +74,8 @@ def open_view(address: str | None, servo=None) -> Iterator[object | None]:
                 servo.observers.append(feed)
             note = "" if server.token is None else " (the token is needed: keep it private)"
             print(f"live view: {server.url}{note}", file=sys.stderr, flush=True)
+            if wait:
+                wait_for_page(server)
             yield server
     finally:
         feed.close()
@@ -57,30 +87,45 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--duration", type=POSITIVE, metavar="S", help="stop after S seconds")
     add_camera_options(p)
     add_matcher_options(p)
+    add_record_options(p)
     p.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
     params = params_from_args(args)
+    check_record(args)
     with contextlib.ExitStack() as stack:
         source = stack.enter_context(open_source(args))
-        geometry = (Calibration.load(args.calib).geometry if args.calib
-                    else Geometry.minoru_default(*parse_size(args.size)))
-        view = stack.enter_context(open_view(args.view))
+        geometry = source_geometry(args, source)
+        view = stack.enter_context(open_view(args.view, wait=args.view_wait))
+        observers = [view.feed]
+        rec = stack.enter_context(recording(args, time.monotonic))
+        if rec is not None:
+            from host.record.tap import RecordingSource, StepRecorder, map_range
+
+            source = RecordingSource(source, rec, geometry)
+            observers.append(StepRecorder(rec, source, map_range(params)))
         t0 = time.monotonic()
 
         def time_left() -> bool:
             return args.duration is None or time.monotonic() - t0 < args.duration
 
-        last = None
+        last, snap = None, None
         for frame in source:
             disp = compute_disparity(frame.left, frame.right, params)
             last = find_marker(frame.left, frame.right, "disc", None, geometry.baseline_m, last)
-            view.feed(Snapshot(time.monotonic() - t0, "view", "no robot: looking only",
-                               frame.left, disp, 0, None, last, None, None, geometry))
+            snap = Snapshot(time.monotonic() - t0, "view", "no robot: looking only", frame.left,
+                            disp, 0, None, last, None, None, geometry)
+            for observer in observers:
+                observer(snap)
             if not time_left():
                 return 0
-        print("host view: the camera ended; the page shows its last frame (Ctrl-C to quit)",
+        ended = getattr(source, "ended", None)
+        how = ended() if callable(ended) else "the camera ended"
+        if snap is not None:  # the page says so too, over the last frame
+            view.feed(dataclasses.replace(snap, t=time.monotonic() - t0, phase="ended",
+                                          reason=f"{how}: the last frame is shown"))
+        print(f"host view: {how}; the page shows its last frame (Ctrl-C to quit)",
               file=sys.stderr, flush=True)
         while time_left():
             time.sleep(0.1)

@@ -8,6 +8,7 @@ and counted; the loop never waits for the view.
 from __future__ import annotations
 
 import bisect
+import dataclasses
 import math
 import threading
 import time
@@ -54,7 +55,8 @@ class ViewFeed:
         self._waiting = 0  # pages waiting for an update
         self._update: Update | None = None
         self._times: deque[float] = deque()
-        self._samples: deque[tuple[float, float | None, float | None, int, int]] = deque()
+        self._samples: deque[tuple[float, float | None, float | None, int | None, int | None]] \
+            = deque()
         self._closed = False
         self._worker = threading.Thread(target=self._run, name="view-encoder", daemon=True)
         self._worker.start()
@@ -72,16 +74,25 @@ class ViewFeed:
             disp = snap.disparity
             if disp is not None and snap.disparity_y0 == 0 and disp.shape == snap.left.shape[:2]:
                 self._full_map = disp
-            if snap.row is not None:
+            if snap.row is not None or snap.phase in ("view", "ended"):
                 self._sample(snap)
             self._cond.notify_all()
 
     def _sample(self, snap: Snapshot) -> None:
+        """A plot sample: the servo's row; in view mode (no robot driven) the nearest object's
+        and the marker's depth as seen, and no duty."""
         row, g = snap.row, snap.geometry
-        target = g.depth_m(row.target_px) if row.target_px > 0 else None
-        robot = g.depth_m(row.robot_px) if row.robot_px > 0 else None  # NaN > 0 is False
+        if row is not None:
+            target_px, robot_px = row.target_px, row.robot_px
+            duty: tuple[int | None, int | None] = (int(row.left), int(row.right))
+        else:
+            target_px = snap.target.disparity if snap.target is not None else math.nan
+            robot_px = snap.marker.disparity if snap.marker is not None else math.nan
+            duty = (None, None)
+        target = g.depth_m(target_px) if target_px > 0 else None  # NaN > 0 is False
+        robot = g.depth_m(robot_px) if robot_px > 0 else None
         self._times.append(snap.t)
-        self._samples.append((snap.t, target, robot, int(row.left), int(row.right)))
+        self._samples.append((snap.t, target, robot, *duty))
         while self._times and self._times[0] < snap.t - self.history_s:
             self._times.popleft()
             self._samples.popleft()
@@ -114,6 +125,14 @@ class ViewFeed:
                 return self._update if self._update and self._update.seq > after else None
             finally:
                 self._waiting -= 1
+
+    def end(self, reason: str) -> None:
+        """The run is over: the last picture again, its phase "ended" with reason (the page
+        says so while it stays up)."""
+        with self._cond:
+            snap = self._latest
+        if snap is not None:
+            self(dataclasses.replace(snap, phase="ended", reason=reason))
 
     @property
     def latest_seq(self) -> int:
