@@ -148,7 +148,9 @@ ROWS = [
     (["tune", "--out", "{tmp}/t.txt"], "is written as a TOML file; name it .toml"),
     (SERVO + ["--log", "{tmp}/missing/dir/run.csv"], "no such folder {tmp}/missing/dir"),
     (DISP + ["-o", "{tmp}"], "is a folder"),
-    (["eval", "--picture", "{tmp}/none"], "--picture {tmp}/none: no such folder"),
+    (["eval", "--picture", "{l}"], "--picture {l}: not a folder"),
+    (["calibrate", "{replay}", "--ros", "{l}"], "--ros {l}: not a folder"),
+    (["calibrate", "{replay}", "--ros", "{ro}/ros"], "--ros {ro}/ros: cannot make the folder"),
     (["calibrate", "{replay}", "--out", "{ro}/calib.yml"], "cannot write in folder"),
     (["capture", "--out", "{ro}"], "--out {ro}: cannot write in folder"),
     (["capture", "--out", "{ro}/shots"], "--out {ro}/shots: cannot write in folder"),
@@ -263,6 +265,13 @@ def test_a_picture_named_from_data_stays_inside_the_folder(
     new = set(_tree(tmp_path)) - set(before)
     assert new == {f"deep/out/{file}"}
     assert not Path("/tmp/abs/x.png").exists()
+
+
+def test_picture_and_ros_folders_are_made_as_capture_makes_its_own(tmp_path: Path) -> None:
+    scene = _scene(tmp_path / "scene", {"scale": 4, "scene": "s"})
+    out = tmp_path / "new" / "pictures"
+    assert main(["eval", str(scene), "--picture", str(out), "--num-disp", "16"]) == 0
+    assert [p.name for p in out.iterdir()] == ["s.png"]
 
 
 @pytest.mark.parametrize("umask", [0o022, 0o002])

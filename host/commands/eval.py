@@ -84,7 +84,7 @@ def _fmt(v: float | None, spec: str = ".2f") -> str:
 
 def run(args: argparse.Namespace) -> int:
     if args.picture:
-        check_folder(args.picture, "--picture")
+        check_folder(args.picture, "--picture", create=True)  # made, as capture makes --out
     params = params_from_args(args)
     scenes = load_scenes(args.scenes, args.scale)
     for scene in scenes:
