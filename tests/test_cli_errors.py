@@ -340,3 +340,14 @@ def test_sigterm_during_tune_is_an_interruption_that_writes_nothing(tmp_path: Pa
     assert late == [] and code == 128 + signal.SIGTERM
     assert capsys.readouterr().err == "host tune: interrupted (SIGTERM)\n"
     assert list(tmp_path.iterdir()) == []
+
+
+def test_an_erased_uno_resetting_over_and_over_is_said_once(capsys) -> None:
+    from host.commands.emulate import RESET_LINES_PER_S, _ResetLines
+    from host.emulator.uno import Reset
+
+    lines = _ResetLines()
+    for i in range(60):  # what an erased chip does in one second
+        lines.add(Reset(i * 266_000, 0x02), 100.0 + i / 60)
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == RESET_LINES_PER_S + 1 and "keeps resetting" in err[-1]
