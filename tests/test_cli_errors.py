@@ -79,6 +79,7 @@ def files(tmp_path: Path) -> dict[str, Path]:
                        ("scene_nan", {"scale": "nan"}),
                        ("scene_top", {"scale": 4, "max_disparity": "abc"})):
         f[name] = _scene(tmp_path / name, meta)
+    f["scene_blank"] = _scene(tmp_path / "scene_blank", {"scale": 4}, blank=True)
     f["replay"].mkdir()
     cv2.imwrite(str(f["replay"] / "left_000.png"), grey)
     cv2.imwrite(str(f["replay"] / "right_000.png"), grey)
@@ -166,6 +167,8 @@ ROWS = [
     (["eval", "{scene_zero}"], "meta.json: needs a positive 'scale'"),
     (["eval", "{scene_nan}"], "meta.json: needs a positive 'scale'"),
     (["eval", "{scene_top}"], "meta.json: needs a positive 'scale'"),
+    (["eval", "{scene_blank}"], "its ground truth has no known pixel"),
+    (["eval", "{scene_blank}", "--picture", "{tmp}/new"], "its ground truth has no known"),
     # inputs: params files
     (DISP + ["-o", "{tmp}/o.png", "--params", "{utf16}"], "not UTF-8 text"),
     (DISP + ["-o", "{tmp}/o.png", "--params", "{big}"], "big.toml: bad value"),
@@ -240,13 +243,13 @@ def test_bad_input_is_one_line_exit_2_and_writes_nothing(
     assert not any(p.name.startswith(".") for p in tmp_path.rglob("*"))  # no temporaries
 
 
-def _scene(folder: Path, meta: object) -> Path:
-    """A scene in the shared layout with this meta.json."""
+def _scene(folder: Path, meta: object, blank: bool = False) -> Path:
+    """A scene in the shared layout with this meta.json (blank: ground truth all unknown)."""
     s = synthetic_scene(seed=3, width=96, height=64, max_disp=12)
     folder.mkdir()
     cv2.imwrite(str(folder / "left.png"), s.left)
     cv2.imwrite(str(folder / "right.png"), s.right)
-    gt = np.nan_to_num(s.gt * 4).astype(np.uint8)
+    gt = np.nan_to_num(s.gt * 4).astype(np.uint8) * (not blank)
     cv2.imwrite(str(folder / "disp_left.png"), gt)
     (folder / "meta.json").write_text(json.dumps(meta))
     return folder

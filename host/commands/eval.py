@@ -11,6 +11,7 @@ from typing import Any
 
 import cv2
 import numba
+import numpy as np
 
 from host.commands.options import (
     POSITIVE,
@@ -83,13 +84,16 @@ def _fmt(v: float | None, spec: str = ".2f") -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.picture:
-        check_folder(args.picture, "--picture", create=True)  # made, as capture makes --out
     params = params_from_args(args)
     scenes = load_scenes(args.scenes, args.scale)
     for scene in scenes:
         if scene.gt is None:
             raise HostError(f"{scene.name}: no ground truth to evaluate against")
+        if not np.isfinite(scene.gt).any():
+            raise HostError(f"{scene.name}: its ground truth has no known pixel (all 0 or "
+                            "unknown): nothing to score against")
+    if args.picture:  # made, as capture makes --out; once the scenes are known to be good
+        check_folder(args.picture, "--picture", create=True)
     with all_or_nothing():  # the pictures appear together, after every scene was scored
         rows = [_score(scene, params, args) for scene in scenes]
     out = [{k: (None if isinstance(v, float) and math.isnan(v) else v)
