@@ -39,6 +39,13 @@ def test_defaults_are_shown() -> None:
     assert "(default: None)" not in text and "(default: False)" not in text
 
 
+def test_one_option_name_has_one_unit() -> None:
+    """--silent-after was seconds in emulate and ms in servo."""
+    for name in ("servo", "emulate"):
+        action = next(a for a in _commands()[name]._actions if a.dest == "silent_after")
+        assert action.metavar == "MS" and "ms" in action.help
+
+
 @pytest.mark.parametrize("name", sorted(_commands()))
 def test_a_flag_shows_no_default(name: str) -> None:
     """--no-lock's default was shown as 'True': a flag's default is its absence."""
