@@ -51,7 +51,8 @@ class _Formatter(argparse.RawDescriptionHelpFormatter):
         text = action.help or ""
         default = action.default
         if ("%(default)" in text or "default" in text or default in (None, False, [])
-                or default is argparse.SUPPRESS or not action.option_strings):
+                or default is argparse.SUPPRESS or not action.option_strings
+                or action.nargs == 0):  # a flag: its default is its absence, not True
             return text
         return text + " (default: %(default)s)"
 

@@ -79,6 +79,7 @@ def files(tmp_path: Path) -> dict[str, Path]:
                        ("scene_nan", {"scale": "nan"}),
                        ("scene_top", {"scale": 4, "max_disparity": "abc"})):
         f[name] = _scene(tmp_path / name, meta)
+    f["scene_blank"] = _scene(tmp_path / "scene_blank", {"scale": 4}, blank=True)
     f["replay"].mkdir()
     cv2.imwrite(str(f["replay"] / "left_000.png"), grey)
     cv2.imwrite(str(f["replay"] / "right_000.png"), grey)
@@ -148,7 +149,9 @@ ROWS = [
     (["tune", "--out", "{tmp}/t.txt"], "is written as a TOML file; name it .toml"),
     (SERVO + ["--log", "{tmp}/missing/dir/run.csv"], "no such folder {tmp}/missing/dir"),
     (DISP + ["-o", "{tmp}"], "is a folder"),
-    (["eval", "--picture", "{tmp}/none"], "--picture {tmp}/none: no such folder"),
+    (["eval", "--picture", "{l}"], "--picture {l}: not a folder"),
+    (["calibrate", "{replay}", "--ros", "{l}"], "--ros {l}: not a folder"),
+    (["calibrate", "{replay}", "--ros", "{ro}/ros"], "--ros {ro}/ros: cannot make the folder"),
     (["calibrate", "{replay}", "--out", "{ro}/calib.yml"], "cannot write in folder"),
     (["capture", "--out", "{ro}"], "--out {ro}: cannot write in folder"),
     (["capture", "--out", "{ro}/shots"], "--out {ro}/shots: cannot write in folder"),
@@ -164,6 +167,8 @@ ROWS = [
     (["eval", "{scene_zero}"], "meta.json: needs a positive 'scale'"),
     (["eval", "{scene_nan}"], "meta.json: needs a positive 'scale'"),
     (["eval", "{scene_top}"], "meta.json: needs a positive 'scale'"),
+    (["eval", "{scene_blank}"], "its ground truth has no known pixel"),
+    (["eval", "{scene_blank}", "--picture", "{tmp}/new"], "its ground truth has no known"),
     # inputs: params files
     (DISP + ["-o", "{tmp}/o.png", "--params", "{utf16}"], "not UTF-8 text"),
     (DISP + ["-o", "{tmp}/o.png", "--params", "{big}"], "big.toml: bad value"),
@@ -238,13 +243,13 @@ def test_bad_input_is_one_line_exit_2_and_writes_nothing(
     assert not any(p.name.startswith(".") for p in tmp_path.rglob("*"))  # no temporaries
 
 
-def _scene(folder: Path, meta: object) -> Path:
-    """A scene in the shared layout with this meta.json."""
+def _scene(folder: Path, meta: object, blank: bool = False) -> Path:
+    """A scene in the shared layout with this meta.json (blank: ground truth all unknown)."""
     s = synthetic_scene(seed=3, width=96, height=64, max_disp=12)
     folder.mkdir()
     cv2.imwrite(str(folder / "left.png"), s.left)
     cv2.imwrite(str(folder / "right.png"), s.right)
-    gt = np.nan_to_num(s.gt * 4).astype(np.uint8)
+    gt = np.nan_to_num(s.gt * 4).astype(np.uint8) * (not blank)
     cv2.imwrite(str(folder / "disp_left.png"), gt)
     (folder / "meta.json").write_text(json.dumps(meta))
     return folder
@@ -263,6 +268,13 @@ def test_a_picture_named_from_data_stays_inside_the_folder(
     new = set(_tree(tmp_path)) - set(before)
     assert new == {f"deep/out/{file}"}
     assert not Path("/tmp/abs/x.png").exists()
+
+
+def test_picture_and_ros_folders_are_made_as_capture_makes_its_own(tmp_path: Path) -> None:
+    scene = _scene(tmp_path / "scene", {"scale": 4, "scene": "s"})
+    out = tmp_path / "new" / "pictures"
+    assert main(["eval", str(scene), "--picture", str(out), "--num-disp", "16"]) == 0
+    assert [p.name for p in out.iterdir()] == ["s.png"]
 
 
 @pytest.mark.parametrize("umask", [0o022, 0o002])
@@ -331,3 +343,14 @@ def test_sigterm_during_tune_is_an_interruption_that_writes_nothing(tmp_path: Pa
     assert late == [] and code == 128 + signal.SIGTERM
     assert capsys.readouterr().err == "host tune: interrupted (SIGTERM)\n"
     assert list(tmp_path.iterdir()) == []
+
+
+def test_an_erased_uno_resetting_over_and_over_is_said_once(capsys) -> None:
+    from host.commands.emulate import RESET_LINES_PER_S, _ResetLines
+    from host.emulator.uno import Reset
+
+    lines = _ResetLines()
+    for i in range(60):  # what an erased chip does in one second
+        lines.add(Reset(i * 266_000, 0x02), 100.0 + i / 60)
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == RESET_LINES_PER_S + 1 and "keeps resetting" in err[-1]

@@ -39,6 +39,20 @@ def test_defaults_are_shown() -> None:
     assert "(default: None)" not in text and "(default: False)" not in text
 
 
+def test_one_option_name_has_one_unit() -> None:
+    """--silent-after was seconds in emulate and ms in servo."""
+    for name in ("servo", "emulate"):
+        action = next(a for a in _commands()[name]._actions if a.dest == "silent_after")
+        assert action.metavar == "MS" and "ms" in action.help
+
+
+@pytest.mark.parametrize("name", sorted(_commands()))
+def test_a_flag_shows_no_default(name: str) -> None:
+    """--no-lock's default was shown as 'True': a flag's default is its absence."""
+    text = " ".join(_commands()[name].format_help().split())
+    assert "(default: True)" not in text and "(default: False)" not in text
+
+
 def test_picture_has_a_colour_bar_in_px_and_a_black_invalid_swatch() -> None:
     disp = np.tile(np.linspace(0, 40, 300, dtype=np.float32), (100, 1))
     disp[:10] = np.nan

@@ -13,7 +13,7 @@ from host.camera.replay import image_pairs
 from host.camera.source import StereoFrame
 from host.commands.options import COUNT, POSITIVE
 from host.errors import HostError
-from host.files import check_output, write_image_atomic
+from host.files import check_folder, check_output, write_image_atomic
 from host.stereo.scenes import read_image
 
 
@@ -41,8 +41,8 @@ def run(args: argparse.Namespace) -> int:
         raise HostError(f"--board needs at least 2x2 inner corners, got {args.board!r}")
     if args.min_views < 3:
         raise HostError("--min-views must be at least 3")
-    if args.ros is not None and not args.ros.is_dir():
-        raise HostError(f"--ros {args.ros}: no such folder")
+    if args.ros is not None:
+        check_folder(args.ros, "--ros", create=True)
     check_output(args.out, "yml", "--out")
     if args.picture is not None:
         check_output(args.picture, "image", "--picture")

@@ -31,8 +31,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--corrupt", type=RATE, default=0.0, metavar="RATE",
                    help="corrupt this share of the bytes, both ways")
     p.add_argument("--delay-ms", type=NON_NEGATIVE, default=0.0, help="delay every byte (ms)")
-    p.add_argument("--silent-after", type=NON_NEGATIVE, metavar="S",
-                   help="stop answering (cut the line) after S seconds")
+    p.add_argument("--silent-after", type=NON_NEGATIVE, metavar="MS",
+                   help="stop answering (cut the line) after MS ms (as host servo's)")
     p.add_argument("--seed", type=SEED, default=0, help="seed of the fault injection")
     p.add_argument("--duration", type=POSITIVE, metavar="S", help="stop after S seconds")
     p.set_defaults(run=run)
@@ -55,7 +55,7 @@ def run(args: argparse.Namespace) -> int:
     if args.uno:
         return _run_uno(args)
     faults = Faults(args.drop, args.corrupt, args.delay_ms,
-                    None if args.silent_after is None else args.silent_after * 1000, args.seed)
+                    args.silent_after, args.seed)
     emu = Emulator(faults)
     with PtyService(emu) as service:
         print(service.path, flush=True)

@@ -11,6 +11,7 @@ from typing import Any
 
 import cv2
 import numba
+import numpy as np
 
 from host.commands.options import (
     POSITIVE,
@@ -96,8 +97,6 @@ def _fmt(v: float | None, spec: str = ".2f") -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.picture:
-        check_folder(args.picture, "--picture")
     params = params_from_args(args)
     scenes = load_scenes(args.scenes, args.scale)
     for scene in scenes:
@@ -105,6 +104,11 @@ def run(args: argparse.Namespace) -> int:
             raise HostError(f"{scene.name}: no ground truth to evaluate against")
         if args.round8 and scene.scale is None:
             raise HostError(f"{scene.name}: no 8-bit ground-truth scale to round to (--round8)")
+        if not np.isfinite(scene.gt).any():
+            raise HostError(f"{scene.name}: its ground truth has no known pixel (all 0 or "
+                            "unknown): nothing to score against")
+    if args.picture:  # made, as capture makes --out; once the scenes are known to be good
+        check_folder(args.picture, "--picture", create=True)
     with all_or_nothing():  # the pictures appear together, after every scene was scored
         rows = [_score(scene, params, args) for scene in scenes]
     out = [{k: (None if isinstance(v, float) and math.isnan(v) else v)

@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -59,3 +60,46 @@ def test_a_bad_ray_address_is_a_one_line_error() -> None:
     r = subprocess.run([sys.executable, "-m", "host", "tune", "--ray", "not an address"],
                        capture_output=True, text=True)
     assert r.returncode == 2 and "--ray ADDRESS" in r.stderr and r.stderr.count("\n") == 1
+
+
+
+class _FakeRay:
+    """Records ray.init's arguments; its init replaces SIGTERM's handler, as Ray's does."""
+
+    def __init__(self) -> None:
+        self.kw: dict = {}
+
+    def is_initialized(self) -> bool:
+        return False
+
+    def init(self, address=None, **kw) -> None:
+        self.kw = {"address": address, **kw}
+        signal.signal(signal.SIGTERM, lambda *_: sys.exit(15))
+
+    def cluster_resources(self) -> dict:
+        return {"CPU": 2}
+
+    def put(self, x):
+        return x
+
+    def remote(self, f):
+        return f
+
+    def shutdown(self) -> None:
+        pass
+
+
+def test_a_local_cluster_binds_loopback_and_keeps_the_commands_signal_handlers(
+        monkeypatch) -> None:
+    from host.tuning.backends import ray_cluster
+
+    fake = _FakeRay()
+    monkeypatch.setattr(ray_cluster, "_ray", lambda: fake)
+    mine = signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    try:
+        ray_cluster.RayBackend(lambda p: [0.0], None)
+        assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL  # not Ray's exit(15)
+    finally:
+        signal.signal(signal.SIGTERM, mine)
+    assert fake.kw["address"] is None and fake.kw["_node_ip_address"] == "127.0.0.1"
+    assert fake.kw["include_dashboard"] is False

@@ -5,10 +5,13 @@ its images) goes to the object store once."""
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
+import signal
 import socket
-from collections.abc import Callable, Sequence
+import threading
+from collections.abc import Callable, Iterator, Sequence
 from typing import Any
 
 from host.errors import HostError
@@ -35,7 +38,8 @@ class RayBackend:
                 kw |= {"num_cpus": os.cpu_count() or 1, "_node_ip_address": LOCAL_IP}
             else:
                 reachable(address)
-            _init(ray, address, kw)
+            with _own_signals():
+                _init(ray, address, kw)
         self.parallel = max(1, int(ray.cluster_resources().get("CPU", 1)))
         self._ref = ray.put(score)
         self._task = ray.remote(_evaluate)
@@ -65,6 +69,21 @@ def reachable(address: str, timeout_s: float = CONNECT_S) -> None:
     except OSError as e:
         why = "no answer" if isinstance(e, TimeoutError) else (e.strerror or str(e))
         raise HostError(f"--ray {address}: no Ray cluster answers there ({why})") from None
+
+
+@contextlib.contextmanager
+def _own_signals() -> Iterator[None]:
+    """Keep the command's signal handlers: ray.init installs a SIGTERM handler that exits with
+    status 15 and Ray's stack dump, where the command ends with 143 and one line."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    kept = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
+    try:
+        yield
+    finally:
+        for s, h in kept.items():
+            signal.signal(s, h)
 
 
 def _init(ray: Any, address: str | None, kw: dict[str, Any], tries: int = 2) -> None:
