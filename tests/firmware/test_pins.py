@@ -15,6 +15,14 @@ from host.link.frame import encode_frame
 from host.link.messages import pack, unpack
 
 MS = F_CPU // 1000
+
+
+def first(items, what: str = "the expected event"):
+    """The first of items; a failed assertion (not StopIteration) when there is none: what the
+    test waits for never happened, which is the firmware's behaviour, not the test's."""
+    for x in items:
+        return x
+    raise AssertionError(f"never happened: {what}")
 NO_RAMP = gen.SetConfig(link_timeout_ms=gen.DEFAULT_LINK_TIMEOUT_MS, accel_limit=0)
 FRAME = len(encode_frame(0, *pack(NO_RAMP)))  # bytes of a SET_CONFIG or SET_DRIVE frame
 
@@ -48,8 +56,8 @@ def test_pins_from_reset_through_init_never_drive_the_bridge(harness, firmware_e
     for motor in ("left", "right"):
         assert enable_pin(last, motor) == Pin(True, 0.0, 0.0)
     # the motors are set up first: the bridge inputs are low outputs within 0.2 ms of reset
-    first = next(io for io in r.io if io.ddrd & 0xF0 == 0xF0)
-    assert first.cycle < 0.2 * MS and first.portd & 0xF0 == 0
+    set_up = first(io for io in r.io if io.ddrd & 0xF0 == 0xF0)
+    assert set_up.cycle < 0.2 * MS and set_up.portd & 0xF0 == 0
     assert messages(r)[0].NAME == "BOOT"
 
 
@@ -60,20 +68,20 @@ def test_a_watchdog_reset_disables_the_watchdog_before_the_c_runtime_runs(harnes
     r = run(harness, hang_elf, s)
     assert len(r.resets) == 1
     after = [io for io in r.io if io.cycle >= r.resets[0]]
-    cleared = next(io for io in after if not io.mcusr & 0x08 and not io.wdtcsr & 0x08)
+    cleared = first(io for io in after if not io.mcusr & 0x08 and not io.wdtcsr & 0x08)
     assert cleared.cycle - r.resets[0] < 100, "WDRF and WDE still set past .init3"
-    armed = next(io for io in after if io.cycle > cleared.cycle and io.wdtcsr & 0x08)
-    motors_set_up = next(io for io in after if io.ddrd & 0xF0 == 0xF0)
+    armed = first(io for io in after if io.cycle > cleared.cycle and io.wdtcsr & 0x08)
+    motors_set_up = first(io for io in after if io.ddrd & 0xF0 == 0xF0)
     assert armed.cycle > motors_set_up.cycle  # main arms it after the motors are off
     assert all(not driving(d) for d in timeline(after, "left"))
 
 
-def reversal(r, motor: str, first: str, then: str) -> tuple[float, list, list]:
-    """Dead interval in ms between the last driven instant in direction first and the first
-    driven instant in direction then, the states in between, and those after."""
+def reversal(r, motor: str, was: str, becomes: str) -> tuple[float, list, list]:
+    """Dead interval in ms between the last driven instant in direction was and the first
+    driven instant in direction becomes, the states in between, and those after."""
     t = timeline(r.io, motor)
-    end = max(i for i, d in enumerate(t) if driving(d) and d.direction == first)
-    start = min(i for i, d in enumerate(t) if driving(d) and d.direction == then)
+    end = max(i for i, d in enumerate(t) if driving(d) and d.direction == was)
+    start = min(i for i, d in enumerate(t) if driving(d) and d.direction == becomes)
     assert end < start
     return (t[start].cycle - t[end + 1].cycle) / MS, t[end + 1:start], t[start:]
 
@@ -87,9 +95,9 @@ def test_reversal_goes_through_zero_and_coasts_before_the_bridge_is_driven_again
     s.run_ms(2).message(1, gen.SetDrive(left=600 * sign, right=600 * sign)).run_ms(200)
     s.message(2, gen.SetDrive(left=-600 * sign, right=-600 * sign)).run_ms(400)
     r = run(harness, firmware_elf, s)
-    first, then = ("forward", "reverse") if sign > 0 else ("reverse", "forward")
+    was, becomes = ("forward", "reverse") if sign > 0 else ("reverse", "forward")
     for motor in ("left", "right"):
-        dead_ms, between, after = reversal(r, motor, first, then)
+        dead_ms, between, after = reversal(r, motor, was, becomes)
         # the direction inputs change only while the enable is off (duty 0 in force at the pin)
         assert between and all(not driving(d) for d in between), motor
         assert gen.DEFAULT_REVERSE_COAST_MS <= dead_ms < gen.DEFAULT_REVERSE_COAST_MS + 2, motor
@@ -98,7 +106,7 @@ def test_reversal_goes_through_zero_and_coasts_before_the_bridge_is_driven_again
             steps = [b.enable.duty - a.enable.duty for a, b in zip(after, after[1:])]
             assert after[0].enable.duty <= 2 * accel / 100 / 1000 + 1e-9, motor
             assert max(steps) <= 2 * accel / 100 / 1000 + 1e-9, motor
-            full = next(d for d in after if d.enable.duty == 0.6)
+            full = first(d for d in after if d.enable.duty == 0.6)
             assert (full.cycle - after[0].cycle) / MS >= 600 / (accel / 100) - 2, motor
 
 
@@ -106,8 +114,8 @@ def test_the_default_ramp_takes_duty_up_at_the_acceleration_limit(harness, firmw
     r = run(harness, firmware_elf, Script().run_ms(2)
             .message(1, gen.SetDrive(left=600, right=0)).run_ms(200))
     t = [d for d in timeline(r.io, "left") if d.cycle > r.last_in_done()]
-    start = next(d for d in t if driving(d))
-    full = next(d for d in t if d.enable.duty == 0.6)
+    start = first(d for d in t if driving(d))
+    full = first(d for d in t if d.enable.duty == 0.6)
     ramp_ms = (full.cycle - start.cycle) / MS
     expected = 600 / (gen.DEFAULT_ACCEL_LIMIT / 100)  # permille / (permille per ms)
     assert expected - 2 <= ramp_ms <= expected + 1, ramp_ms
@@ -126,8 +134,8 @@ def test_the_motors_stop_250_ms_after_the_last_accepted_drive_whatever_follows(
     r = run(harness, firmware_elf, s)
     drive_done = r.ins[2 * FRAME - 1][0] + CYCLES_PER_BYTE  # the SET_DRIVE's stop bit
     t = [d for d in timeline(r.io, "left") if d.cycle > drive_done]
-    on = next(i for i, d in enumerate(t) if driving(d))
-    off = next(d for d in t[on:] if not driving(d))
+    on = first(i for i, d in enumerate(t) if driving(d))
+    off = first(d for d in t[on:] if not driving(d))
     stop_ms = (off.cycle - drive_done) / MS
     assert gen.DEFAULT_LINK_TIMEOUT_MS <= stop_ms < gen.DEFAULT_LINK_TIMEOUT_MS + 2, stop_ms
     assert all(not driving(d) for d in t if d.cycle > off.cycle)

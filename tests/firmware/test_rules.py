@@ -16,6 +16,14 @@ from host.link.frame import encode_frame
 from host.link.messages import pack, unpack
 
 MS = F_CPU // 1000
+
+
+def first(items, what: str = "the expected event"):
+    """The first of items; a failed assertion (not StopIteration) when there is none: what the
+    test waits for never happened, which is the firmware's behaviour, not the test's."""
+    for x in items:
+        return x
+    raise AssertionError(f"never happened: {what}")
 NO_RAMP = gen.SetConfig(link_timeout_ms=gen.DEFAULT_LINK_TIMEOUT_MS, accel_limit=0)
 
 
@@ -58,8 +66,8 @@ def driving(d) -> bool:
 def stops_after(r, cycle: int, motor: str = "left") -> float:
     """ms from cycle to the first instant the motor's bridge is off, having been driven."""
     t = [d for d in timeline(r.io, motor) if d.cycle > cycle]
-    on = next(i for i, d in enumerate(t) if driving(d))
-    off = next(d for d in t[on:] if not driving(d))
+    on = first(i for i, d in enumerate(t) if driving(d))
+    off = first(d for d in t[on:] if not driving(d))
     return (off.cycle - cycle) / MS
 
 
@@ -143,8 +151,8 @@ def test_stop_then_reverse_coasts_before_the_bridge_is_driven_again(harness, fir
     r = run(harness, firmware_elf, p.script)
     for motor in ("left", "right"):
         t = timeline(r.io, motor)
-        off = next(d for d in t if d.cycle > done(r, p, "stop") - 100 and not driving(d))
-        back = next(d for d in t if d.cycle > off.cycle and driving(d))
+        off = first(d for d in t if d.cycle > done(r, p, "stop") - 100 and not driving(d))
+        back = first(d for d in t if d.cycle > off.cycle and driving(d))
         assert back.direction == "reverse"
         assert (back.cycle - off.cycle) / MS >= gen.DEFAULT_REVERSE_COAST_MS, motor
 
@@ -318,7 +326,7 @@ def test_a_false_start_on_the_line_does_not_swallow_the_keepalives(harness, firm
     p.msg(2, gen.GetStatus()).run(5)
     r = run(harness, firmware_elf, p.script)
     t = [d for d in timeline(r.io, "left") if d.cycle > done(r, p, "drive")]
-    on = next(i for i, d in enumerate(t) if driving(d))
+    on = first(i for i, d in enumerate(t) if driving(d))
     assert all(driving(d) for d in t[on:]), "the motors were cut"
     status = messages(r)[-1]
     assert status.NAME == "STATUS" and status.link_losses == 0
@@ -334,7 +342,7 @@ def test_a_frame_with_gaps_between_its_bytes_is_dropped(harness, firmware_elf) -
     r = run(harness, firmware_elf, p.script)
     got = messages(r)
     assert [m.seq for m in got if m.NAME == "ACK"] == [0, 5]  # the gapped frame never counted
-    status = next(m for m in got if m.NAME == "STATUS")
+    status = first(m for m in got if m.NAME == "STATUS")
     assert status.framing_errors >= 1 and status.left == 0
     assert timeline(r.io, "left")[-1].enable.duty == 0.3
 

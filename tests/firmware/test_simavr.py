@@ -14,6 +14,14 @@ from host.link.frame import encode_frame
 from host.link.messages import describe, pack, unpack
 
 MS = F_CPU // 1000
+
+
+def first(items, what: str = "the expected event"):
+    """The first of items; a failed assertion (not StopIteration) when there is none: what the
+    test waits for never happened, which is the firmware's behaviour, not the test's."""
+    for x in items:
+        return x
+    raise AssertionError(f"never happened: {what}")
 ROOT = Path(__file__).resolve().parents[2]
 
 
@@ -42,8 +50,8 @@ def test_set_drive_sets_compare_registers_and_direction_pins(harness, firmware_e
     change = r.settled()[-1]
     # duty permille * ICR1 (400) / 1000; IN1 (bit 0) = left forward, IN4 (bit 3) = right reverse
     assert (change.ocr1a, change.ocr1b, change.dir) == (200, 100, 0b1001)
-    first = next(p for p in r.pwm if p.cycle > r.last_in_done())
-    latency = first.cycle - r.last_in_done()
+    applied = first(p for p in r.pwm if p.cycle > r.last_in_done())
+    latency = applied.cycle - r.last_in_done()
     assert 0 < latency < 4000, f"{latency} cycles from the last byte's stop bit to the PWM"
     assert messages(r)[-1] == gen.Ack(seq=1, result=gen.AckResult.APPLIED)
 
@@ -94,7 +102,7 @@ def test_watchdog_resets_a_hung_firmware_with_the_motors_off(harness, hang_elf) 
     # two WDTO_30MS periods (interrupt, then reset); simavr times one at 32 ms
     assert 60 <= (r.resets[0] - hang_start) / MS <= 68
     driving = [p for p in r.settled() if p.cycle < hang_start][-1]
-    stopped = next(p for p in r.settled() if p.cycle > hang_start)
+    stopped = first(p for p in r.settled() if p.cycle > hang_start)
     # the watchdog interrupt stops the motors one period into the hang, before the reset
     # (both enables low: the bridge is off; the direction inputs keep their levels at duty 0)
     assert driving.ocr1a == 200 and (stopped.ocr1a, stopped.ocr1b) == (0, 0)
@@ -104,8 +112,8 @@ def test_watchdog_resets_a_hung_firmware_with_the_motors_off(harness, hang_elf) 
     msgs = messages(r)
     boots = [m for m in msgs if isinstance(m, gen.Boot)]
     assert [b.reset_cause for b in boots] == [gen.ResetCause.POWER_ON, gen.ResetCause.WATCHDOG]
-    hello = next(m for m in msgs if isinstance(m, gen.HelloReply))
-    status = next(m for m in msgs if isinstance(m, gen.Status))
+    hello = first(m for m in msgs if isinstance(m, gen.HelloReply))
+    status = first(m for m in msgs if isinstance(m, gen.Status))
     assert hello.reset_cause == gen.ResetCause.WATCHDOG
     assert status.flags & gen.StatusFlag.WATCHDOG_RESET
 
