@@ -2,7 +2,8 @@
 30 fps for 60 s (or --seconds), recording every frame (both views raw, each disparity map, the
 marker, target, phase, drive, link and the robot's STATUS once a second), as `host servo --sim
 --record` does; then the loop's top rate with and without recording, as fast as it goes, in
-interleaved rounds.
+interleaved rounds. The same real-time run without recording is the control: on a loaded
+machine it shows how much of a shortfall is the load's.
 
 Reported: the real-time run's loop rate (goal: >= 30 Hz, every pair recorded, nothing
 dropped; pairs come at their capture times, and wait for a slow loop as a camera's do), pairs
@@ -105,7 +106,8 @@ def main() -> int:
         per_min = 60.0 / args.seconds
         print(f"real time, {args.seconds:g} s recorded: loop {m['loop_hz']:.1f} Hz "
               f"({m['steps']} steps in {m['wall_s']:.1f} s), {m['late']} pairs late to their "
-              f"pace, recorder dropped {m['dropped']} of {sum(m['queued'].values())} items, "
+              f"pace, recorder dropped {m['dropped']} of "
+              f"{m['dropped'] + sum(m['queued'].values())} items, "
               f"{m['written']} messages; CPU a step: loop thread {m['loop_cpu_ms']:.1f} ms, "
               f"process {m['cpu_ms']:.1f} ms ({m['cpu_share'] * 100:.0f}% of one core); "
               f"closing took {m['close_s']:.1f} s; load {m['load']:.2f}; phases {m['phases']}")
@@ -114,6 +116,11 @@ def main() -> int:
               f"uncompressed", flush=True)
         failed = m["loop_hz"] < 0.98 * FPS or m["dropped"] > 0
         path.unlink()
+        c = run(size, params, args.seconds, None, args.compression, paced=True)
+        print(f"real time, {args.seconds:g} s not recorded (the control): loop "
+              f"{c['loop_hz']:.1f} Hz, {c['late']} pairs late; CPU a step: loop thread "
+              f"{c['loop_cpu_ms']:.1f} ms, process {c['cpu_ms']:.1f} ms; load {c['load']:.2f}",
+              flush=True)
         rates: dict[str, list[float]] = {"no record": [], "record": []}
         cpu: dict[str, list[tuple[float, float]]] = {"no record": [], "record": []}
         for r in range(args.rounds):
@@ -122,8 +129,8 @@ def main() -> int:
                 f = run(size, params, args.fast_seconds, rec, args.compression, paced=False)
                 rates[name].append(f["loop_hz"])
                 cpu[name].append((f["loop_cpu_ms"], f["cpu_ms"]))
-                extra = (f", recorder dropped {f['dropped']} of {sum(f['queued'].values())}"
-                         if rec else "")
+                offered = f["dropped"] + sum(f["queued"].values()) if rec else 0
+                extra = f", recorder dropped {f['dropped']} of {offered}" if rec else ""
                 print(f"  as fast as it goes, round {r + 1} {name:>9}: loop {f['loop_hz']:5.1f} "
                       f"Hz; CPU a step: loop thread {f['loop_cpu_ms']:5.1f} ms, process "
                       f"{f['cpu_ms']:5.1f} ms{extra}; load {f['load']:.2f}",

@@ -7,12 +7,12 @@ import sys
 from pathlib import Path
 
 import host
-from host.commands import calibrate, cameras, capture, disparity, emulate, servo, tune, view
+from host.commands import bag, calibrate, cameras, capture, disparity, emulate, servo, tune, view
 from host.commands import eval as eval_cmd
 from host.errors import describe
 from host.signals import signals_interrupt
 
-COMMANDS = [eval_cmd, disparity, tune, cameras, capture, calibrate, servo, emulate, view]
+COMMANDS = [eval_cmd, disparity, tune, cameras, capture, calibrate, servo, emulate, view, bag]
 
 
 # one or two examples per command (a command module may define EXAMPLES itself instead)

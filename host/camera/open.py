@@ -115,7 +115,10 @@ def open_source(args: argparse.Namespace, speed: float = 1.0) -> StereoSource:
     a bag's CameraInfo is not the identity); a bag at args.speed, else speed."""
     spec = args.camera
     rectify = Rectifier(Calibration.load(args.calib)) if args.calib else None  # before a camera
-    if spec.startswith("replay:") and is_bag(Path(spec[len("replay:"):])):
+    bag = spec.startswith("replay:") and is_bag(Path(spec[len("replay:"):]))
+    if getattr(args, "speed", None) is not None and not bag:
+        raise HostError(f"--speed paces a replay:FILE.mcap (or --sim), not --camera {spec}")
+    if bag:
         speed = speed if getattr(args, "speed", None) is None else args.speed
         source: StereoSource = BagSource(Path(spec[len("replay:"):]), speed)
         calib = source.calibration  # type: ignore[attr-defined]

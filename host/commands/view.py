@@ -42,10 +42,10 @@ def wait_for_page(server, poll_s: float = 0.05) -> None:
 def hold_view(server, reason: str) -> None:
     """After the run: the page says it has ended (reason) and stays up until Ctrl-C, which
     then ends the command as the run did (not as an interrupt)."""
-    server.feed.end(reason)
-    print("live view: the run has ended; the page stays up until Ctrl-C", file=sys.stderr,
-          flush=True)
-    try:
+    try:  # from before the line is printed: a Ctrl-C as soon as it is seen ends the wait
+        server.feed.end(reason)
+        print("live view: the run has ended; the page stays up until Ctrl-C", file=sys.stderr,
+              flush=True)
         while True:
             time.sleep(0.2)
     except KeyboardInterrupt:

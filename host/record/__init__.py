@@ -48,9 +48,10 @@ def recording(args: argparse.Namespace, clock: Callable[[], float]) -> Iterator[
     if getattr(args, "record", None) is None:
         yield None
         return
-    from host.record.writer import Recorder
+    from host.record.writer import QUEUE_ITEMS, Recorder
 
-    rec = Recorder(args.record, clock, args.record_compression)
+    rec = Recorder(args.record, clock, args.record_compression,
+                   getattr(args, "record_queue", QUEUE_ITEMS))  # tests: room for every item
     try:
         yield rec
     finally:

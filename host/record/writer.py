@@ -1,15 +1,16 @@
 """The recording's file and its worker: a rosbag2 in MCAP storage (profile ros2, schemas
 ros2msg, messages CDR), written by the mcap library from a worker thread fed by a bounded queue.
 
-The loop's thread only queues (a closure and its references, no copy, no encoding); a full
-queue drops the item and counts it, and /diagnostics says how many ("recorder" status) once a
-second and at the end, as the file's rosbag2 metadata does. Chunks are written whole as they
-fill (unbuffered file), so a run killed at any moment leaves every chunk but the last one it
-was filling readable.
+The loop's thread only queues (a closure and its references, no copy, no encoding); the worker
+runs at a lower priority; a full queue drops the item and counts it, and /diagnostics says how
+many ("recorder" status) once a second and at the end, as the file's rosbag2 metadata does.
+Chunks are written whole as they fill (unbuffered file), so a run killed at any moment leaves
+every chunk but the last one it was filling readable.
 """
 
 from __future__ import annotations
 
+import os
 import queue
 import threading
 import time
@@ -110,6 +111,20 @@ class BagFile:
                 f"  custom_data:\n{data}")
 
 
+WORKER_NICE = 10  # the worker yields the CPU to the loop: a busy machine drops, not stalls
+
+
+def _lower_priority() -> None:
+    """This thread at a lower scheduling priority (Linux: threads have their own nice value),
+    so that on a loaded machine the recorder falls behind and drops (counted) before it slows
+    the loop. Where that is not possible it runs as it is."""
+    try:
+        tid = threading.get_native_id()
+        os.setpriority(os.PRIO_PROCESS, tid, os.getpriority(os.PRIO_PROCESS, tid) + WORKER_NICE)
+    except (AttributeError, OSError):
+        pass
+
+
 class Recorder:
     """Records from any thread without waiting: put(kind, build) queues build (run later on
     the worker, returning (topic, message, ns) triples); stamps come from ns(t), t on the
@@ -173,6 +188,7 @@ class Recorder:
             "recorder", level, text, self._stats())]), ns)
 
     def _run(self) -> None:
+        _lower_priority()
         while True:
             item = self._queue.get()
             if item is None:

@@ -17,7 +17,9 @@ def run(tmp_path_factory):
     from host.sim.run import Setup, simulation
 
     path = tmp_path_factory.mktemp("rec") / "run.mcap"
-    args = argparse.Namespace(record=path, record_compression="zstd")
+    # a queue with room for every item: the lockstep loop outruns a real camera, and on a
+    # loaded machine the (lower-priority) worker would drop some
+    args = argparse.Namespace(record=path, record_compression="zstd", record_queue=10_000)
     seen = []
     faults = WorldFaults(camera=CameraFaults(skew_ms=8.0))  # the right view's stamps differ
     with simulation(Setup((320, 240), 1.9, faults=faults), reference=False) as sim:

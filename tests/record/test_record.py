@@ -167,6 +167,17 @@ def test_a_killed_run_leaves_a_file_that_opens_to_its_last_chunk(tmp_path):
             ended = True  # the chunk being filled when the run was killed
     assert images >= 12  # three chunks of 4 MB hold at least this many pairs
     assert ended  # cut off where the run was killed, not closed
+    # readers that need the summary refuse it; host bag --repair makes a closed copy they open
+    with pytest.raises(Exception):  # noqa: B017 (rosbags' own error: the end magic is missing)
+        Reader(path).open()
+    fixed = tmp_path / "fixed.mcap"
+    r = subprocess.run([sys.executable, "-m", "host", "bag", str(path), "--repair", str(fixed)],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert "the file is cut off" in r.stdout
+    topics = _rosbags(fixed)
+    assert len(topics["/stereo/left/image_raw"]) == images
+    assert not (tmp_path / "fixed.mcap.part").exists()
 
 
 def test_a_recorder_that_falls_behind_drops_counts_and_says_so(tmp_path):
