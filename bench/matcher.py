@@ -140,7 +140,7 @@ def speed(kind: str, paths: tuple[int, ...] = (5,)) -> None:
 
 
 PEAK = """
-import json, resource, sys
+import json, sys
 import numpy as np
 import numba
 import cv2
@@ -153,28 +153,56 @@ small = rng.integers(0, 256, (48, 32 + p.num_disparities), dtype=np.uint8)
 compute_disparity(small, small, p.replace(num_disparities=16))  # load the kernels
 wide = rng.integers(0, 256, (h, w + 32), dtype=np.uint8)
 left, right = np.ascontiguousarray(wide[:, 32:]), np.ascontiguousarray(wide[:, :w])
-def rss():
-    with open("/proc/self/statm") as f:
-        return int(f.read().split()[1]) * resource.getpagesize()
-before = rss()
-compute_disparity(left, right, p)
-print((resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024 - before) / (w * h))
+print("go", flush=True)
+sys.stdin.readline()
+for _ in range(int(sys.argv[4])):
+    compute_disparity(left, right, p)
+print("done", flush=True)
+sys.stdin.readline()
 """
 
 
-def peak_bytes_per_pixel(p: MatcherParams, w: int, h: int) -> float:
-    """Peak resident memory a call adds, in bytes per pixel (a fresh process, one thread)."""
+def _anon_bytes(pid: int) -> int:
+    """Anonymous resident memory of a process (file pages, which memory pressure on a shared
+    machine drops and reads back, left out)."""
+    with open(f"/proc/{pid}/status") as f:
+        for line in f:
+            if line.startswith("RssAnon:"):
+                return int(line.split()[1]) * 1024
+    raise OSError(f"no RssAnon in /proc/{pid}/status")
+
+
+def peak_bytes_per_pixel(p: MatcherParams, w: int, h: int, calls: int = 3) -> float:
+    """Peak anonymous memory a call adds, in bytes per pixel: a fresh process (one thread)
+    runs the matcher `calls` times while this one samples its RssAnon every 0.2 ms."""
     fields = {k: getattr(p, k) for k in ("matcher", "mode", "block_size", "num_disparities",
                                          "lr_check", "fill", "border", "colour", "paths",
                                          "uniqueness_ratio", "speckle_window_size",
                                          "speckle_range")}
-    out = subprocess.run([sys.executable, "-c", PEAK, str(w), str(h), json.dumps(fields)],
-                         capture_output=True, text=True, check=True)
-    return float(out.stdout.split()[-1])
+    child = subprocess.Popen([sys.executable, "-c", PEAK, str(w), str(h), json.dumps(fields),
+                              str(calls)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                             text=True)
+    try:
+        if child.stdout.readline().strip() != "go":
+            raise RuntimeError("the memory probe did not start")
+        before = _anon_bytes(child.pid)
+        child.stdin.write("\n")
+        child.stdin.flush()
+        peak = before
+        os.set_blocking(child.stdout.fileno(), False)
+        while not child.stdout.readline():
+            peak = max(peak, _anon_bytes(child.pid))
+            time.sleep(0.0002)
+        child.stdin.write("\n")
+        child.stdin.flush()
+    finally:
+        child.wait(timeout=60)
+    return (peak - before) / (w * h)
 
 
 def memory() -> None:
-    print("\n## peak memory a call adds (one thread, fresh process, random pair), B / pixel")
+    print("\n## peak anonymous memory a call adds (one thread, fresh process, random pair, "
+          "sampled every 0.2 ms), B / pixel")
     for w, h, nd in MEMORY_SIZES:
         own = peak_bytes_per_pixel(OWN_SGM.replace(num_disparities=nd), w, h)
         ref = peak_bytes_per_pixel(SGBM_3WAY.replace(num_disparities=nd, colour=False), w, h)
