@@ -30,6 +30,9 @@ class LinkError(HostError):
     """The serial link or the robot failed; the message is one line."""
 
 
+UPTIME_SLACK_MS = 250
+
+
 class RobotReset(LinkError):
     """The robot reset during the session; the link has said HELLO again, re-applied its
     configuration and sent STOP: the robot stands."""
@@ -273,7 +276,7 @@ class RobotLink:
         stop for link loss is counted and noted (the next SET_DRIVE drives again); a robot that
         drives after STOP raises LinkError. A robot that does not answer is left to the next
         command to report."""
-        self._status_t = self._now()
+        asked = self._status_t = self._now()
         try:
             s = self.status()
         except RobotReset:
@@ -282,17 +285,18 @@ class RobotLink:
             if "did not answer" in str(e):
                 return
             raise
-        now = self._now()
         least = None
-        if self._uptime is not None:  # what the uptime must have reached, with some slack for
-            # the reply's time on the line and the robot's crystal
-            elapsed_ms = (now - self._uptime[1]) * 1000
-            least = self._uptime[0] + int(elapsed_ms * 0.98) - 50
+        if self._uptime is not None:  # what the uptime must have reached when this STATUS was
+            # first asked for, less a slack for the robot's crystal and for a robot whose clock
+            # lags (an emulator's thread starved on a loaded machine): a reset within the slack
+            # after a handshake is seen by the other checks only
+            elapsed_ms = (asked - self._uptime[1]) * 1000
+            least = self._uptime[0] + int(elapsed_ms * 0.98) - UPTIME_SLACK_MS
         why = health_problem(s, self.hello, least, self._config)
         if why:
             raise self._resync(f"the robot reset during the session without its BOOT frame "
                                f"({why}): {explain_reset(s.reset_cause)}")
-        self._uptime = (s.uptime_ms, now)
+        self._uptime = (s.uptime_ms, self._now())  # that uptime was read by now
         driving = bool(s.flags & gen.StatusFlag.DRIVING)
         if self._last_drive is not None and s.flags & gen.StatusFlag.LINK_LOST:
             self.link_losses += 1

@@ -129,3 +129,14 @@ def test_a_port_that_never_takes_a_write_is_lost(monkeypatch) -> None:
     monkeypatch.setattr("host.link.port.SerialPort.__init__.__defaults__", (1.0, 0.05))
     with pytest.raises(LinkError, match="lost the serial port starved://: write timeout"):
         RobotLink("starved://").open()
+
+
+def test_a_robot_clock_that_lags_the_host_is_not_taken_for_a_reset() -> None:
+    """An emulator's thread starved on a loaded machine answers with an uptime up to a few
+    hundred ms behind the host's clock: that is no reset."""
+    emu, clock, port = line()
+    with RobotLink(port, status_s=0.5) as robot:
+        drive_for(robot, clock, 1.0)
+        clock.ms += 200  # the host's clock runs on while the robot's stands (starved)
+        drive_for(robot, clock, 1.0)
+        assert robot.resets == 0
