@@ -72,6 +72,7 @@ class ServoConfig:
     robot_half_width_m: float = 0.12  # the image region left out of the re-measure
     robot_below_marker_m: float = 0.22
     lane_margin_m: float = 0.05  # watched beyond the stopping distance
+    lane_stop_s: float = 3.0  # an object in the lane this long ends the run
     timing: TimingConfig = field(default_factory=TimingConfig)
     estimator: EstimatorConfig = field(default_factory=EstimatorConfig)
     acquire: AcquireConfig = field(default_factory=AcquireConfig)
@@ -149,6 +150,8 @@ class Servo:
         self._strips: StripMap | None = None  # the re-measure's map, a band per frame
         self._remeasure_t: float | None = None
         self._cmd = Command(0, 0, "wait", None)  # the command in force
+        self._blocked_since: float | None = None  # when the lane ahead was first blocked
+        self._blocked_last = -math.inf  # when it was last
         self._width = 0
 
     @property
@@ -466,6 +469,12 @@ class Servo:
                 assert self.controller is not None
                 self.controller.phase = "obstacle"
                 invalid = invalid or blocked
+                self._blocked_since = self._blocked_since or t
+                self._blocked_last = t
+                if t - self._blocked_since >= self.cfg.lane_stop_s:
+                    self.stop_reason = f"{blocked} for {self.cfg.lane_stop_s:g} s"
+            elif t - self._blocked_last > 1.0:  # clear for a second (standing, the watched
+                self._blocked_since = None  # stretch is shorter: clear now and then)
         t_send = time.perf_counter()
         self._send(cmd)
         rtt_ms = (time.perf_counter() - t_send) * 1000
