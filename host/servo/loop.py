@@ -26,6 +26,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+import cv2
 import numpy as np
 
 from host.camera.calibration import Geometry
@@ -73,6 +74,7 @@ class ServoConfig:
     robot_below_marker_m: float = 0.22
     lane_margin_m: float = 0.05  # watched beyond the stopping distance
     lane_stop_s: float = 3.0  # an object in the lane this long ends the run
+    lane_width_px: int = 320  # the lane is watched on frames scaled down to about this width
     timing: TimingConfig = field(default_factory=TimingConfig)
     estimator: EstimatorConfig = field(default_factory=EstimatorConfig)
     acquire: AcquireConfig = field(default_factory=AcquireConfig)
@@ -133,6 +135,9 @@ class Servo:
         self.timing = FrameTiming(self.cfg.timing)
         self.frozen = FrozenSensors()
         self.reference_map: np.ndarray | None = None  # the scene without the robot, px
+        self._lane_scale = 1  # the lane's frames are this many times smaller
+        self._lane_geometry = geometry
+        self._lane_reference: np.ndarray | None = None
         self.estimator = Estimator(geometry, self.cfg.estimator)
         self.acquisition = Acquisition(self.cfg.acquire)
         self.tracker: TargetTracker | None = None
@@ -212,6 +217,12 @@ class Servo:
         self._width = w
         target, self.floor = reference_target(disps, min_area)
         self.reference_map = median_map(disps)
+        k = self._lane_scale = max(1, w // self.cfg.lane_width_px)
+        g = self.geometry
+        self._lane_geometry = Geometry(g.focal_px / k, g.baseline_m, (g.cx + 0.5) / k - 0.5,
+                                       (g.cy + 0.5) / k - 0.5)
+        self._lane_reference = (self.reference_map if k == 1 else cv2.resize(
+            self.reference_map, (w // k, h // k), interpolation=cv2.INTER_NEAREST) / k)
         self.tracker = TargetTracker(target, min_area, self.cfg.tracker)
         self.controller = Controller(self.geometry.depth_m(target.disparity), self.control)
         self.controller.keep_out = self._extent(
@@ -356,15 +367,22 @@ class Servo:
         duty = abs(self._cmd.left + self._cmd.right) / 2
         speed = max(abs(est.state.vz), est.cfg.max_speed_mps * duty / 1000)
         reach = stopping_distance_m(speed) + self.cfg.lane_margin_m
-        h, w = frame.left.shape[:2]
-        window = lane_window(self.geometry, (w, h), z, x, direction, reach)
+        k = self._lane_scale
+        g = self._lane_geometry
+        left, right = frame.left, frame.right
+        if k > 1:  # the lane at 320x240 or so: an obstacle is large, the match costs k^3 less
+            size = (left.shape[1] // k, left.shape[0] // k)
+            left = cv2.resize(left, size, interpolation=cv2.INTER_AREA)
+            right = cv2.resize(right, size, interpolation=cv2.INTER_AREA)
+        h, w = left.shape[:2]
+        window = lane_window(g, (w, h), z, x, direction, reach)
         if window is None:
             return ""
-        disp = match_window(frame.left, frame.right, self.params, window)
+        disp = match_window(left, right, self.params, window)
         if self.last_pair is not None:  # the robot's own body (its texture mismatches)
             x0, y0, x1, y1 = self._robot_region(self.last_pair, frame.left.shape)
-            disp[y0:y1, x0:x1] = np.nan
-        found = lane_obstacle(disp, self.geometry, z, x, direction, reach, self.reference_map)
+            disp[y0 // k:-(-y1 // k), x0 // k:-(-x1 // k)] = np.nan
+        found = lane_obstacle(disp, g, z, x, direction, reach, self._lane_reference)
         if found is None:
             return ""
         return f"an object in the lane {found.ahead_m:.2f} m ahead"
