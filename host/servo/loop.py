@@ -50,6 +50,7 @@ from host.servo.perception import (
     stopping_distance_m,
     without_floor,
 )
+from host.servo.rig import reference_image, vertical_shift_px
 from host.servo.snapshot import Observer, Snapshot, link_stats
 from host.servo.timing import FrameTiming, TimingConfig
 from host.servo.tracker import TargetTracker, TrackerConfig
@@ -74,6 +75,7 @@ class ServoConfig:
     robot_below_marker_m: float = 0.22
     lane_margin_m: float = 0.05  # watched beyond the stopping distance
     lane_stop_s: float = 3.0  # an object in the lane this long ends the run
+    moved_rows: float = 0.005  # of the focal length (0.3 degrees of pitch): the camera moved
     lane_width_px: int = 320  # the lane is watched on frames scaled down to about this width
     timing: TimingConfig = field(default_factory=TimingConfig)
     estimator: EstimatorConfig = field(default_factory=EstimatorConfig)
@@ -138,6 +140,7 @@ class Servo:
         self._lane_scale = 1  # the lane's frames are this many times smaller
         self._lane_geometry = geometry
         self._lane_reference: np.ndarray | None = None
+        self._reference_image: np.ndarray | None = None
         self.estimator = Estimator(geometry, self.cfg.estimator)
         self.acquisition = Acquisition(self.cfg.acquire)
         self.tracker: TargetTracker | None = None
@@ -206,8 +209,10 @@ class Servo:
 
     def reference(self) -> Target:
         disps = []
-        for _ in range(self.cfg.reference_frames):
+        for i in range(self.cfg.reference_frames):
             f = self._exposed(self._frame())
+            if i == 0:
+                self._reference_image = reference_image(f.left)
             disps.append(compute_disparity(f.left, f.right, self.params))
             self._notify(f, "reference", "measuring the scene", disps[-1], 0, None, None)
             self.link.stop()  # keeps the link alive while the robot waits
@@ -335,12 +340,16 @@ class Servo:
     def _remeasure(self, disp: np.ndarray, frame: StereoFrame) -> None:
         """The tracker's measure on the whole map disp (the robot's region NaN); first, that
         the camera has not moved since the reference (the floor fit would no longer remove
-        the floor, and its rows pass for the object): if it has, the run stops."""
+        the floor, and its rows pass for the object): the floor off its line and the picture
+        shifted, the run stops."""
         assert self.tracker is not None and self.controller is not None
         moved = camera_moved(disp, self.floor, reference=self.reference_map)
-        if moved:
-            self.stop_reason = moved
-            return
+        if moved and self._reference_image is not None:  # and the picture itself moved: an
+            # object put down over the floor's rows shifts their disparity too
+            dy = vertical_shift_px(self._reference_image, frame.left)
+            if abs(dy) >= self.cfg.moved_rows * self.geometry.focal_px:
+                self.stop_reason = f"{moved} (the picture moved {dy:+.1f} rows)"
+                return
         clean = without_floor(disp, self.floor)
         target = self.tracker.update(clean, lambda t: views_agree(
             frame.left, frame.right, t.bbox, t.disparity))
