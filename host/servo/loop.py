@@ -31,7 +31,7 @@ import numpy as np
 
 from host.camera.calibration import Geometry
 from host.camera.source import CameraError, StereoFrame, StereoSource
-from host.servo.acquire import AcquireConfig, Acquisition
+from host.servo.acquire import NOT_MOVED, AcquireConfig, Acquisition
 from host.servo.controller import Command, ControlConfig, Controller, Observation
 from host.servo.estimator import AGAINST, OUTSIDE, STILL, Estimator, EstimatorConfig, Sighting
 from host.servo.inputs import FrozenSensors, camera_moved, views_agree
@@ -76,6 +76,7 @@ class ServoConfig:
     lane_margin_m: float = 0.05  # watched beyond the stopping distance
     lane_stop_s: float = 3.0  # an object in the lane this long ends the run
     moved_rows: float = 0.005  # of the focal length (0.3 degrees of pitch): the camera moved
+    acquire_tries: int = 3  # look-alikes that do not move, left out one after the other
     lane_width_px: int = 320  # the lane is watched on frames scaled down to about this width
     timing: TimingConfig = field(default_factory=TimingConfig)
     estimator: EstimatorConfig = field(default_factory=EstimatorConfig)
@@ -160,6 +161,7 @@ class Servo:
         self._cmd = Command(0, 0, "wait", None)  # the command in force
         self._blocked_since: float | None = None  # when the lane ahead was first blocked
         self._blocked_last = -math.inf  # when it was last
+        self._statics: list[tuple[float, float]] = []  # where non-moving look-alikes stand
         self._width = 0
 
     @property
@@ -275,6 +277,11 @@ class Servo:
         b = pair.left
         return Sighting(t, pair.disparity, b.u, 2 * b.radius / (1 + min(1.0, b.aspect)))
 
+    def _static(self, pair: MarkerPair) -> bool:
+        """Whether the pair is where a marker that did not move with the robot was seen."""
+        return any(abs(pair.left.u - u) + abs(pair.left.v - v) < 3 * pair.left.radius + 4
+                   for u, v in self._statics)
+
     def _see(self, frame: StereoFrame) -> _Seen:
         """The marker: the best candidate the estimator's gate admits and block matching over
         it confirms. Candidates near the last sighting first; all of them refused, the whole
@@ -289,6 +296,8 @@ class Servo:
                                            whole=whole)
             checked = 0
             for pair in candidates:
+                if self.estimator.state is None and self._static(pair):
+                    continue  # shown not to move with the robot: not its marker
                 why = self.estimator.gate(self._sighting(frame.t_left, pair))
                 if why:
                     seen.rejected = seen.rejected or why
@@ -425,6 +434,18 @@ class Servo:
                 assert self.controller is not None
                 acq.direction = 1 if position[0] < self.controller.target_m else -1
         order = acq.update(t, position, None if position is None else d, noise_m)
+        if acq.fault == NOT_MOVED and self.last_pair is not None \
+                and len(self._statics) < self.cfg.acquire_tries - 1:
+            # what was taken for the marker did not move with the robot (another robot, a
+            # disc on the wall): acquire again, leaving it out
+            self._statics.append((self.last_pair.left.u, self.last_pair.left.v))
+            self.notes.append(f"the marker seen at ({self.last_pair.left.u:.0f}, "
+                              f"{self.last_pair.left.v:.0f}) px did not move with the robot: "
+                              f"looking for another")
+            self.estimator.forget()
+            self.last_pair = None
+            self.acquisition = Acquisition(self.cfg.acquire)
+            return Command(0, 0, "find", None)
         if acq.fault:
             self.stop_reason = acq.fault
         if before == "measure" and acq.phase != "measure":
