@@ -110,7 +110,11 @@ class Acquisition:
             first, last = self._track[:5], self._track[-5:]
             dz = float(np.median([p[1] for p in last]) - np.median([p[1] for p in first]))
             dx = float(np.median([p[2] for p in last]) - np.median([p[2] for p in first]))
-            if math.hypot(dz, dx) >= max(cfg.probe_m, 3 * noise_m):
+            moved = math.hypot(dz, dx)
+            # by probe_s, far away (noisy) a move of probe_m decides: the motion check
+            # corrects a wrong call
+            if moved >= max(cfg.probe_m, 3 * noise_m) or (
+                    t - self._t0 > cfg.probe_s and moved >= cfg.probe_m):
                 self.facing_away = (dz > 0) == (self.direction > 0)
                 self._begin(DONE, t)
                 return Order(0, 0, PROBE)

@@ -26,11 +26,12 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+import cv2
 import numpy as np
 
 from host.camera.calibration import Geometry
 from host.camera.source import CameraError, StereoFrame, StereoSource
-from host.servo.acquire import AcquireConfig, Acquisition
+from host.servo.acquire import NOT_MOVED, AcquireConfig, Acquisition
 from host.servo.controller import Command, ControlConfig, Controller, Observation
 from host.servo.estimator import AGAINST, OUTSIDE, STILL, Estimator, EstimatorConfig, Sighting
 from host.servo.inputs import FrozenSensors, camera_moved, views_agree
@@ -49,6 +50,7 @@ from host.servo.perception import (
     stopping_distance_m,
     without_floor,
 )
+from host.servo.rig import reference_image, vertical_shift_px
 from host.servo.snapshot import Observer, Snapshot, link_stats
 from host.servo.timing import FrameTiming, TimingConfig
 from host.servo.tracker import TargetTracker, TrackerConfig
@@ -72,6 +74,10 @@ class ServoConfig:
     robot_half_width_m: float = 0.12  # the image region left out of the re-measure
     robot_below_marker_m: float = 0.22
     lane_margin_m: float = 0.05  # watched beyond the stopping distance
+    lane_stop_s: float = 3.0  # an object in the lane this long ends the run
+    moved_rows: float = 0.005  # of the focal length (0.3 degrees of pitch): the camera moved
+    acquire_tries: int = 3  # look-alikes that do not move, left out one after the other
+    lane_width_px: int = 320  # the lane is watched on frames scaled down to about this width
     timing: TimingConfig = field(default_factory=TimingConfig)
     estimator: EstimatorConfig = field(default_factory=EstimatorConfig)
     acquire: AcquireConfig = field(default_factory=AcquireConfig)
@@ -132,6 +138,10 @@ class Servo:
         self.timing = FrameTiming(self.cfg.timing)
         self.frozen = FrozenSensors()
         self.reference_map: np.ndarray | None = None  # the scene without the robot, px
+        self._lane_scale = 1  # the lane's frames are this many times smaller
+        self._lane_geometry = geometry
+        self._lane_reference: np.ndarray | None = None
+        self._reference_image: np.ndarray | None = None
         self.estimator = Estimator(geometry, self.cfg.estimator)
         self.acquisition = Acquisition(self.cfg.acquire)
         self.tracker: TargetTracker | None = None
@@ -149,6 +159,9 @@ class Servo:
         self._strips: StripMap | None = None  # the re-measure's map, a band per frame
         self._remeasure_t: float | None = None
         self._cmd = Command(0, 0, "wait", None)  # the command in force
+        self._blocked_since: float | None = None  # when the lane ahead was first blocked
+        self._blocked_last = -math.inf  # when it was last
+        self._statics: list[tuple[float, float]] = []  # where non-moving look-alikes stand
         self._width = 0
 
     @property
@@ -198,8 +211,10 @@ class Servo:
 
     def reference(self) -> Target:
         disps = []
-        for _ in range(self.cfg.reference_frames):
+        for i in range(self.cfg.reference_frames):
             f = self._exposed(self._frame())
+            if i == 0:
+                self._reference_image = reference_image(f.left)
             disps.append(compute_disparity(f.left, f.right, self.params))
             self._notify(f, "reference", "measuring the scene", disps[-1], 0, None, None)
             self.link.stop()  # keeps the link alive while the robot waits
@@ -209,6 +224,12 @@ class Servo:
         self._width = w
         target, self.floor = reference_target(disps, min_area)
         self.reference_map = median_map(disps)
+        k = self._lane_scale = max(1, w // self.cfg.lane_width_px)
+        g = self.geometry
+        self._lane_geometry = Geometry(g.focal_px / k, g.baseline_m, (g.cx + 0.5) / k - 0.5,
+                                       (g.cy + 0.5) / k - 0.5)
+        self._lane_reference = (self.reference_map if k == 1 else cv2.resize(
+            self.reference_map, (w // k, h // k), interpolation=cv2.INTER_NEAREST) / k)
         self.tracker = TargetTracker(target, min_area, self.cfg.tracker)
         self.controller = Controller(self.geometry.depth_m(target.disparity), self.control)
         self.controller.keep_out = self._extent(
@@ -256,6 +277,11 @@ class Servo:
         b = pair.left
         return Sighting(t, pair.disparity, b.u, 2 * b.radius / (1 + min(1.0, b.aspect)))
 
+    def _static(self, pair: MarkerPair) -> bool:
+        """Whether the pair is where a marker that did not move with the robot was seen."""
+        return any(abs(pair.left.u - u) + abs(pair.left.v - v) < 3 * pair.left.radius + 4
+                   for u, v in self._statics)
+
     def _see(self, frame: StereoFrame) -> _Seen:
         """The marker: the best candidate the estimator's gate admits and block matching over
         it confirms. Candidates near the last sighting first; all of them refused, the whole
@@ -270,6 +296,8 @@ class Servo:
                                            whole=whole)
             checked = 0
             for pair in candidates:
+                if self.estimator.state is None and self._static(pair):
+                    continue  # shown not to move with the robot: not its marker
                 why = self.estimator.gate(self._sighting(frame.t_left, pair))
                 if why:
                     seen.rejected = seen.rejected or why
@@ -321,12 +349,16 @@ class Servo:
     def _remeasure(self, disp: np.ndarray, frame: StereoFrame) -> None:
         """The tracker's measure on the whole map disp (the robot's region NaN); first, that
         the camera has not moved since the reference (the floor fit would no longer remove
-        the floor, and its rows pass for the object): if it has, the run stops."""
+        the floor, and its rows pass for the object): the floor off its line and the picture
+        shifted, the run stops."""
         assert self.tracker is not None and self.controller is not None
         moved = camera_moved(disp, self.floor, reference=self.reference_map)
-        if moved:
-            self.stop_reason = moved
-            return
+        if moved and self._reference_image is not None:  # and the picture itself moved: an
+            # object put down over the floor's rows shifts their disparity too
+            dy = vertical_shift_px(self._reference_image, frame.left)
+            if abs(dy) >= self.cfg.moved_rows * self.geometry.focal_px:
+                self.stop_reason = f"{moved} (the picture moved {dy:+.1f} rows)"
+                return
         clean = without_floor(disp, self.floor)
         target = self.tracker.update(clean, lambda t: views_agree(
             frame.left, frame.right, t.bbox, t.disparity))
@@ -353,15 +385,22 @@ class Servo:
         duty = abs(self._cmd.left + self._cmd.right) / 2
         speed = max(abs(est.state.vz), est.cfg.max_speed_mps * duty / 1000)
         reach = stopping_distance_m(speed) + self.cfg.lane_margin_m
-        h, w = frame.left.shape[:2]
-        window = lane_window(self.geometry, (w, h), z, x, direction, reach)
+        k = self._lane_scale
+        g = self._lane_geometry
+        left, right = frame.left, frame.right
+        if k > 1:  # the lane at 320x240 or so: an obstacle is large, the match costs k^3 less
+            size = (left.shape[1] // k, left.shape[0] // k)
+            left = cv2.resize(left, size, interpolation=cv2.INTER_AREA)
+            right = cv2.resize(right, size, interpolation=cv2.INTER_AREA)
+        h, w = left.shape[:2]
+        window = lane_window(g, (w, h), z, x, direction, reach)
         if window is None:
             return ""
-        disp = match_window(frame.left, frame.right, self.params, window)
+        disp = match_window(left, right, self.params, window)
         if self.last_pair is not None:  # the robot's own body (its texture mismatches)
             x0, y0, x1, y1 = self._robot_region(self.last_pair, frame.left.shape)
-            disp[y0:y1, x0:x1] = np.nan
-        found = lane_obstacle(disp, self.geometry, z, x, direction, reach, self.reference_map)
+            disp[y0 // k:-(-y1 // k), x0 // k:-(-x1 // k)] = np.nan
+        found = lane_obstacle(disp, g, z, x, direction, reach, self._lane_reference)
         if found is None:
             return ""
         return f"an object in the lane {found.ahead_m:.2f} m ahead"
@@ -395,6 +434,18 @@ class Servo:
                 assert self.controller is not None
                 acq.direction = 1 if position[0] < self.controller.target_m else -1
         order = acq.update(t, position, None if position is None else d, noise_m)
+        if acq.fault == NOT_MOVED and self.last_pair is not None \
+                and len(self._statics) < self.cfg.acquire_tries - 1:
+            # what was taken for the marker did not move with the robot (another robot, a
+            # disc on the wall): acquire again, leaving it out
+            self._statics.append((self.last_pair.left.u, self.last_pair.left.v))
+            self.notes.append(f"the marker seen at ({self.last_pair.left.u:.0f}, "
+                              f"{self.last_pair.left.v:.0f}) px did not move with the robot: "
+                              f"looking for another")
+            self.estimator.forget()
+            self.last_pair = None
+            self.acquisition = Acquisition(self.cfg.acquire)
+            return Command(0, 0, "find", None)
         if acq.fault:
             self.stop_reason = acq.fault
         if before == "measure" and acq.phase != "measure":
@@ -466,6 +517,12 @@ class Servo:
                 assert self.controller is not None
                 self.controller.phase = "obstacle"
                 invalid = invalid or blocked
+                self._blocked_since = self._blocked_since or t
+                self._blocked_last = t
+                if t - self._blocked_since >= self.cfg.lane_stop_s:
+                    self.stop_reason = f"{blocked} for {self.cfg.lane_stop_s:g} s"
+            elif t - self._blocked_last > 1.0:  # clear for a second (standing, the watched
+                self._blocked_since = None  # stretch is shorter: clear now and then)
         t_send = time.perf_counter()
         self._send(cmd)
         rtt_ms = (time.perf_counter() - t_send) * 1000

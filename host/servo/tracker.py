@@ -3,7 +3,8 @@ with the floor and the robot left out) follows it when it moves (median of the l
 retargets onto a nearer object only once NearerObject vouches for it (three re-measures running
 at the same place and depth, its two views agreeing: a flicker phantom moves and does not
 match), and ends the run ("target vanished") when most of its area twice shows what lay behind
-it (a pure state machine)."""
+it and its two views no longer agree at its disparity (a map spoilt by flicker is not a box
+gone; a pure state machine)."""
 
 from __future__ import annotations
 
@@ -24,6 +25,7 @@ class TrackerConfig:
     history: int = 3  # re-measures the target's disparity is the median of
     agree: int = 2  # re-measures that must agree before a "vanished"
     overlap: float = 0.3  # of the narrower region's width: the same object
+    still_there: float = 0.6  # views agreeing this well at the object's disparity: not gone
 
 
 class TargetTracker:
@@ -57,6 +59,8 @@ class TargetTracker:
         vouched = self.nearer.update(found if nearer else None,
                                      agreement(found) if nearer and found else float("nan"))
         if found is not None and overlap:
+            if not agreement(found) >= self.cfg.still_there:
+                return old  # its two views disagree there: a spoilt map (flicker), not it
             self._doubt = (0, "")
             self.history.append(found.disparity)
             del self.history[:-self.cfg.history]
@@ -66,7 +70,7 @@ class TargetTracker:
         # gone means seen through: most of the object's area now shows what lies behind it; a
         # region hidden by something nearer (or masked as the robot) is not gone
         behind = int(np.count_nonzero(there < old.disparity - max(1.0, 0.1 * old.disparity)))
-        if behind >= old.area // 2:
+        if behind >= old.area // 2 and not agreement(old) >= self.cfg.still_there:
             n = self._doubt[0] + 1 if self._doubt[1] == "vanished" else 1
             self._doubt = (n, "vanished")
             if n >= self.cfg.agree:
