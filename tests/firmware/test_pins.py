@@ -80,8 +80,10 @@ def reversal(r, motor: str, was: str, becomes: str) -> tuple[float, list, list]:
     """Dead interval in ms between the last driven instant in direction was and the first
     driven instant in direction becomes, the states in between, and those after."""
     t = timeline(r.io, motor)
-    end = max(i for i, d in enumerate(t) if driving(d) and d.direction == was)
-    start = min(i for i, d in enumerate(t) if driving(d) and d.direction == becomes)
+    was_on = [i for i, d in enumerate(t) if driving(d) and d.direction == was]
+    becomes_on = [i for i, d in enumerate(t) if driving(d) and d.direction == becomes]
+    assert was_on and becomes_on, f"{motor} never driven {was} and then {becomes}"
+    end, start = max(was_on), min(becomes_on)
     assert end < start
     return (t[start].cycle - t[end + 1].cycle) / MS, t[end + 1:start], t[start:]
 
