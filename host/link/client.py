@@ -65,11 +65,17 @@ class RobotLink:
 
     def __init__(self, port: str | Port, *, baud: int = gen.BAUD, reply_timeout_s: float = 0.1,
                  retries: int = 8, handshake_s: float = 3.0, keepalive_s: float = 0.08,
-                 status_s: float = 0.5, expected_hash: int = gen.SCHEMA_HASH,
+                 status_s: float = 0.5, drive_budget_s: float | None = 0.2,
+                 expected_hash: int = gen.SCHEMA_HASH,
                  rng: random.Random | None = None) -> None:
         self.port = port if isinstance(port, str) else getattr(port, "name", "the robot's line")
         self._port_arg = port
         self.status_s = status_s  # how often drive() first checks the robot's STATUS; 0: never
+        # a drive() not confirmed within this long (its STATUS check included) is given up and
+        # the robot sent STOP instead: while the host resends, the robot runs on the command
+        # before, on an observation that grows old (None: the retries alone bound it)
+        self.drive_budget_s = drive_budget_s
+        self.unconfirmed = 0  # drives given up for a STOP (drive_budget_s)
         self.baud = baud
         self.reply_timeout_s = reply_timeout_s
         self.retries = retries
@@ -220,12 +226,16 @@ class RobotLink:
         self._poll_seq = (self._poll_seq + 1) & 0xFF
         return self._poll_seq
 
-    def _transact(self, msg: Any, match: Callable[[Any, int], bool], seq: int) -> Any:
+    def _transact(self, msg: Any, match: Callable[[Any, int], bool], seq: int,
+                  until: float | None = None) -> Any:
         """Send msg as seq and wait for the reply match accepts; resend on silence or a CRC
-        NACK."""
+        NACK. With until (this link's clock), no resend whose wait would end after it: None
+        when no reply came by then (the first try is always made)."""
         frame = encode_frame(seq, *pack(msg))
         sent_before = frame == self._last_command
         for attempt in range(self.retries):
+            if attempt and until is not None and self._now() + self.reply_timeout_s > until:
+                return None
             self.resends += attempt > 0
             self._write(frame)
             if msg.ID != gen.GetStatus.ID:
@@ -249,28 +259,36 @@ class RobotLink:
         raise LinkError(f"the robot did not answer {msg.NAME} after {self.retries} tries "
                         f"({self.reply_timeout_s * 1000:.0f} ms each)")
 
-    def command(self, msg: Any) -> Any:
-        """Send a command and return its ACK."""
+    def command(self, msg: Any, until: float | None = None) -> Any:
+        """Send a command and return its ACK (None: none came by until, see _transact)."""
         ack = self._transact(msg, lambda m, seq: isinstance(m, (gen.Ack, gen.Nack))
-                             and m.seq == seq, self._next_seq())
-        if ack.result == gen.AckResult.DUPLICATE:
+                             and m.seq == seq, self._next_seq(), until)
+        if ack is not None and ack.result == gen.AckResult.DUPLICATE:
             self.duplicates += 1
         return ack
 
     def drive(self, left: int, right: int) -> None:
         """Set both motors' duty in permille (-1000..1000, positive = forward). The robot's
         STATUS is checked first (check_health) every status_s, and when no drive was sent for
-        the robot's link timeout."""
+        the robot's link timeout. Not confirmed within drive_budget_s (the check included),
+        the drive is given up: the robot is sent STOP and a note says so."""
         now = self._now()
+        until = now + self.drive_budget_s if self.drive_budget_s is not None else None
         timeout_s = (self._config[0] if self._config else self.hello.link_timeout_ms) / 1000
         if self.status_s and (now - self._status_t >= self.status_s or self._last_drive
                               and now - self._last_drive_sent >= timeout_s):
-            self.check_health()  # when due, and when the robot may have stopped for link loss
-        self.command(gen.SetDrive(left=int(left), right=int(right)))
+            # when due, and when the robot may have stopped for link loss
+            self.check_health(until)
+        if self.command(gen.SetDrive(left=int(left), right=int(right)), until) is None:
+            self.unconfirmed += 1
+            self.notes.append(f"SET_DRIVE {left} {right} not confirmed within "
+                              f"{self.drive_budget_s * 1000:.0f} ms: STOP sent instead")
+            self.stop()
+            return
         self._last_drive = (int(left), int(right))
         self._last_drive_sent = self._now()
 
-    def check_health(self) -> None:
+    def check_health(self, until: float | None = None) -> None:
         """Ask STATUS and judge it against what this host did: a reset (uptime back, another
         cause, the configuration back at its defaults) re-handshakes and raises RobotReset; a
         stop for link loss is counted and noted (the next SET_DRIVE drives again); a robot that
@@ -278,7 +296,9 @@ class RobotLink:
         command to report."""
         asked = self._status_t = self._now()
         try:
-            s = self.status()
+            s = self.status(until)
+            if s is None:  # no answer by until: the next check asks again
+                return
         except RobotReset:
             raise
         except LinkError as e:
@@ -322,10 +342,10 @@ class RobotLink:
         self.command(gen.SetConfig(link_timeout_ms=link_timeout_ms, accel_limit=accel_limit))
         self._config = (link_timeout_ms, accel_limit)
 
-    def status(self) -> Any:
-        """The robot's STATUS message."""
+    def status(self, until: float | None = None) -> Any:
+        """The robot's STATUS message (None: none came by until, see _transact)."""
         return self._transact(gen.GetStatus(), lambda m, seq: isinstance(m, gen.Status) or (
-            isinstance(m, gen.Nack) and m.seq == seq), self._next_poll_seq())
+            isinstance(m, gen.Nack) and m.seq == seq), self._next_poll_seq(), until)
 
     def close(self) -> None:
         """Stop the motors (best effort) and close the port."""

@@ -140,3 +140,40 @@ def test_a_robot_clock_that_lags_the_host_is_not_taken_for_a_reset() -> None:
         clock.ms += 200  # the host's clock runs on while the robot's stands (starved)
         drive_for(robot, clock, 1.0)
         assert robot.resets == 0
+
+
+class DeafLine(LockstepLine):
+    """A line whose robot-to-host direction can be cut while the host's bytes still arrive (a
+    noisy return wire): the robot applies commands whose ACKs the host never sees."""
+
+    deaf = False
+
+    def read(self, wait_s: float) -> bytes:
+        data = super().read(wait_s)
+        return b"" if self.deaf else data
+
+
+def test_a_drive_not_confirmed_within_its_budget_becomes_a_stop() -> None:
+    """While the host resends an unconfirmed SET_DRIVE the robot runs on the command before, on
+    an observation that grows old: the link gives the drive up within drive_budget_s and
+    sends STOP, so the robot does not drive on for all the retries (8 x 100 ms)."""
+    emu = Emulator(Faults())
+    clock = Clock(emu)
+    seen: list[tuple[int, tuple[int, int]]] = []
+
+    def advance(ms: int) -> None:
+        clock.advance(ms)
+        seen.append((clock.ms, emu.motors()))
+
+    port = DeafLine(emu, advance, lambda: clock.ms)
+    with RobotLink(port, status_s=0, drive_budget_s=0.2) as robot:
+        robot.set_config(link_timeout_ms=1000, accel_limit=0)
+        robot.drive(300, 300)
+        advance(30)
+        port.deaf = True
+        t0 = clock.ms
+        with pytest.raises(LinkError, match="did not answer STOP"):
+            robot.drive(400, 400)  # given up at the budget; the STOP is not answered either
+        assert robot.unconfirmed == 1 and "STOP sent instead" in robot.notes[-1]
+        stopped_at = next(t for t, m in seen if t > t0 and m == (0, 0))
+        assert stopped_at - t0 <= 200 + 20  # the budget, and the first STOP on the line
