@@ -50,3 +50,31 @@ def native_build(tmp_path_factory):
         return exe
 
     return build
+
+
+# The slow tiers: `pytest -m "not slow"` is the fast subset a change is first checked with;
+# `make test` runs everything. A test file is in a tier for what it needs (why, beside it).
+SLOW_FILES = {
+    "tests/firmware/test_simavr.py": "the firmware's ELF in simavr",
+    "tests/firmware/test_uno.py": "the simulated Uno through its bootloader",
+    "tests/firmware/test_platformio.py": "PlatformIO builds and uploads",
+    "tests/firmware/test_watchdog.py": "watchdog periods in simavr",
+    "tests/firmware/test_budget.py": "floods in simavr",
+    "tests/firmware/test_libfuzzer.py": "clang builds and fuzz runs",
+    "tests/firmware/test_pins.py": "the firmware's pins in simavr",
+    "tests/view/test_browser.py": "a browser",
+    "tests/view/test_sim_watch.py": "real-time simulated runs",
+    "tests/tuning/test_ray_backend.py": "Ray",
+    "tests/sim/test_trials.py": "trial campaigns, Ray",
+    "tests/sim/test_events.py": "closed-loop runs of every event",
+    "tests/servo/test_closed_loop.py": "closed-loop runs",
+    "tests/record": "recorded simulated runs",
+    "tests/packaging": "builds and installs the package",
+}
+
+
+def pytest_collection_modifyitems(config, items) -> None:
+    for item in items:
+        rel = Path(str(item.fspath)).resolve().relative_to(ROOT).as_posix()
+        if any(rel == p or rel.startswith(p + "/") for p in SLOW_FILES):
+            item.add_marker(pytest.mark.slow)
