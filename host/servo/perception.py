@@ -388,7 +388,7 @@ def lane_obstacle(disp: np.ndarray, geometry: Geometry, depth_m: float, lateral_
                   direction: int, reach_m: float, reference: np.ndarray | None = None,
                   half_width_m: float = 0.12, body_m: float = 0.10, floor_clear_m: float = 0.03,
                   height_m: float = 0.30, camera_height_m: float = 0.25, tol_px: float = 1.0,
-                  min_pixels: int = 40, robot_px: int = 4) -> LaneObstacle | None:
+                  min_size_m: float = 0.04, robot_px: int = 4) -> LaneObstacle | None:
     """An object in the robot's lane within reach_m ahead of its front, or None.
 
     Each valid pixel of disp is a point in the world (x = B (u - cx) / d, z = f B / d, height
@@ -400,7 +400,8 @@ def lane_obstacle(disp: np.ndarray, geometry: Geometry, depth_m: float, lateral_
     (the mismatches along its silhouette), and, with a reference map (the scene without the
     robot, same geometry), nearer than what the reference had there by tol_px (the object the
     robot drives to and the wall are not new). The largest connected patch of such pixels, if
-    it has at least min_pixels: the obstacle, at its median depth. Moving away from the camera
+    it covers at least a min_size_m square at its depth ((min_size_m f / z)^2 px; at least 25):
+    the obstacle, at its median depth. Moving away from the camera
     the robot hides what is right behind it: a low object is seen only beside or above it.
 
     A result (not None) means: stop now, before it closes; reach_m is the stopping distance at
@@ -428,13 +429,14 @@ def lane_obstacle(disp: np.ndarray, geometry: Geometry, depth_m: float, lateral_
         ref = reference[vs, us]
         with np.errstate(invalid="ignore"):
             keep &= ~(ref >= d - tol_px)  # NaN in the reference: unknown, so new
-    if int(keep.sum()) < min_pixels:
+    if int(keep.sum()) < 25:
         return None
     mask = np.zeros(disp.shape, np.uint8)
     mask[vs[keep], us[keep]] = 1
     _, labels, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
     best = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
-    if stats[best, cv2.CC_STAT_AREA] < min_pixels:
-        return None
     zm = float(np.median(fb / disp[labels == best]))
-    return LaneObstacle(zm, (zm - depth_m) * direction, int(stats[best, cv2.CC_STAT_AREA]))
+    area = int(stats[best, cv2.CC_STAT_AREA])
+    if area < max(25.0, (min_size_m * g.focal_px / zm) ** 2):
+        return None
+    return LaneObstacle(zm, (zm - depth_m) * direction, area)

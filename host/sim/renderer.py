@@ -105,8 +105,9 @@ class Renderer:
 
     def _render_static(self, pad: int) -> list[tuple[np.ndarray, np.ndarray]]:
         """The static views with pad extra rows above and below (0: the view itself); the
-        view's rows are the same with or without them (extra rows of texture come from a
-        stream of their own)."""
+        view's rows are the same with or without them, to a thousandth of a grey level (the
+        extra rows of texture come from a stream of their own, the layers paint in the same
+        order)."""
         world = self.world
         g, (w, h) = world.geometry, world.size
         rng = np.random.default_rng(self.seed)
@@ -125,9 +126,18 @@ class Renderer:
         layers = [Layer(fb / world.wall_z_m, tex(1.2, 40, 150), margin)]
         # floor: a point at depth z is at row cy + f h / z, so d = B (y - cy) / h (y below cy)
         horizon = g.cy + g.focal_px * world.height_m / world.wall_z_m + pad
-        layers.append(Layer(-g.baseline_m * (g.cy + pad) / world.height_m, tex(0.9, 35, 95),
-                            margin, dy=g.baseline_m / world.height_m,
-                            box=(-1e4, horizon, 1e4, 1e4)))
+        floor_d0, floor_dy = -g.baseline_m * (g.cy + pad) / world.height_m, g.baseline_m / \
+            world.height_m
+        floor_tex = tex(0.9, 35, 95)
+        # the floor in the view's rows is one layer, as without the extra rows (render_view
+        # paints in the order of each layer's mean disparity over its visible part: a floor
+        # reaching lower would be painted over boxes it was painted under), the rows below
+        # another
+        layers.append(Layer(floor_d0, floor_tex, margin, dy=floor_dy,
+                            box=(-1e4, horizon, 1e4, h + pad if pad else 1e4)))
+        if pad:
+            layers.append(Layer(floor_d0, floor_tex, margin, dy=floor_dy,
+                                box=(-1e4, h + pad, 1e4, 1e4)))
         for b in sorted(world.boxes, key=lambda b: -b.z_m):
             x0, y0 = world.project(b.x0_m, b.height_m, b.z_m)
             x1, y1 = world.project(b.x1_m, 0.0, b.z_m)

@@ -116,6 +116,18 @@ class World:
         u, v = self.project(r.x_m, r.marker_height_m, r.z_m)
         return u, v, self.geometry.focal_px * self.geometry.baseline_m / r.z_m
 
+    def bumped_into(self) -> str:
+        """What the robot's body (body_width_m wide) overlaps, besides boxes: "a person" (a
+        slab 10 cm deep), "another robot" or "" (a judge's truth; boxes are the trials')."""
+        r = self.robot
+        for p in self.people:
+            if abs(r.z_m - p.z_m) < 0.1 and abs(r.x_m - p.x_m) < (p.width_m + r.body_width_m) / 2:
+                return "a person"
+        for o in self.decoys:
+            if abs(r.z_m - o.z_m) < 0.12 and abs(r.x_m - o.x_m) < r.body_width_m:
+                return "another robot"
+        return ""
+
     def step(self, dt: float, duty_left: float, duty_right: float) -> None:
         """Move the robot for dt seconds under the duties its wheels get (permille), through
         the motor faults: gain and offset per wheel, battery sag with distance, wheel slip,

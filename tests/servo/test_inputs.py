@@ -133,3 +133,6 @@ def test_a_nearer_object_is_vouched_for_only_when_it_persists_in_both_views() ->
     deeper = Target(33.0, 900, (100, 50, 40, 40), 0.2)  # same place, 10 % nearer
     for t in (box, deeper, box):
         assert gate.update(t, 0.9) is None
+    gate.reset()
+    for x in (40, 100, 160):  # a person crossing: wide, overlapping, real, but moving
+        assert gate.update(Target(28.0, 20000, (x, 0, 210, 240), 0.3), 0.95) is None

@@ -65,19 +65,6 @@ OBJECT_CLAIMS = ("the robot's line passes through the object",
                  "pushed sideways onto the object while holding")
 
 
-def _hit_someone(sim: SimRun) -> str:
-    """The robot's body (16 cm) overlaps a person (their slab, 10 cm deep) or another robot
-    (counted while it drives: someone walking into a robot that stands is not its doing)."""
-    r = sim.world.robot
-    for p in sim.world.people:
-        if abs(r.z_m - p.z_m) < 0.1 and abs(r.x_m - p.x_m) < p.width_m / 2 + r.body_width_m / 2:
-            return "ran into a person"
-    for o in sim.world.decoys:
-        if abs(r.z_m - o.z_m) < 0.12 and abs(r.x_m - o.x_m) < r.body_width_m:
-            return "ran into the other robot"
-    return ""
-
-
 def _judge(sim: SimRun, seconds: float, last_event: float) -> Outcome:
     servo, source = sim.servo, sim.source
     last_valid, frozen_since = source.t, None
@@ -91,7 +78,9 @@ def _judge(sim: SimRun, seconds: float, last_event: float) -> Outcome:
         driving = abs(left + right) / 2 > 60
         frozen_since = (frozen_since or source.t) if source.frozen else None
         err = sim.world.robot.z_m - target_z()
-        why = _unsafe(sim, last_valid, servo.stale_s) or (_hit_someone(sim) if driving else "")
+        why = _unsafe(sim, last_valid, servo.stale_s)
+        if not why and driving and sim.world.bumped_into():  # walking into a robot that
+            why = f"ran into {sim.world.bumped_into()}"  # stands is not the robot's doing
         if not why and driving and frozen_since is not None and \
                 source.t - frozen_since > servo.stale_s + 0.05:
             why = f"drove {source.t - frozen_since:.2f} s on a frozen sensor"

@@ -17,7 +17,7 @@ from host.sim.faults import (
 )
 from host.sim.renderer import Renderer
 from host.sim.source import SimSource
-from host.sim.world import World
+from host.sim.world import Person, Robot, World
 
 
 class Board:
@@ -261,3 +261,27 @@ def test_a_decoy_shows_a_second_marker_at_its_depth() -> None:
     u, v, disp = source.world.marker_truth(d)
     assert f.left[int(round(v)), int(round(u))] < 60  # its dark disc
     assert f.right[int(round(v)), int(round(u - disp))] < 60
+
+
+def test_the_world_says_when_the_robot_bumps_into_someone() -> None:
+    world = World()
+    world.robot.z_m, world.robot.x_m = 1.0, 0.0
+    world.people = (Person(0.25, 1.05),)
+    assert world.bumped_into() == "a person"
+    world.people = (Person(0.35, 1.05),)  # 0.225 + 0.08 from its centre: clear
+    assert world.bumped_into() == ""
+    world.decoys = (Robot(x_m=0.1, z_m=1.0),)
+    assert world.bumped_into() == "another robot"
+
+
+def test_a_knock_leaves_the_scene_as_it_was_only_seen_from_elsewhere() -> None:
+    """The rows a pitched rig sees beyond the view are added without changing the view's own
+    (target boxes at 1.0-1.5 m: at 1.3 m a floor reaching lower once painted over the box)."""
+    from host.sim.world import Box
+
+    for z in (1.0, 1.3, 1.5):
+        world = World(seed=3, boxes=(Box(z, -0.50, -0.18, 0.38), Box(1.8, 0.22, 0.55, 0.30)))
+        r = Renderer(world, seed=3)
+        for side in (0, 1):
+            plain, padded = r._render_static(0)[side][0], r._render_static(16)[side][0]
+            assert np.abs(padded[16:16 + 240] - plain).max() < 0.01
