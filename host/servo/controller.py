@@ -18,8 +18,8 @@ Turn: spin until the marker, lost edge-on, is seen again; the card's apparent as
 height = |cos| of its angle) when it was lost and when it returned, and the time between, give
 the turn rate actually achieved; the spin goes on for the remaining angle at that rate (an
 absence shorter than min_gap_s is a missed detection, not the card's back, and is forgotten).
-Then re-acquisition: driving waits for the marker; if the card never came back in the turn, the
-robot spins slowly on to find it.
+Then re-acquisition: driving waits for the marker; if the card is not seen after the turn (it
+never came back, or the turn ended with it edge-on), the robot spins slowly on to find it.
 Lateral: the marker's position x = B (u - cx) / d is held on a lane: where it was first seen,
 unless that line passes the object (keep_out, the object's lateral extent at its depth, from the
 servo) closer than clearance_m, centre to side; then the lane moves to the nearer clear side.
@@ -269,7 +269,7 @@ class Controller:
                 return self._spin(None)
             return self._end_turn(obs.t)
         if obs.t - turn["t0"] > self.cfg.turn_timeout_s:
-            return self._end_turn(obs.t, search=True)  # the card never came back: look for it
+            return self._end_turn(obs.t)  # the card never came back: look for it
         if seen and turn["lost_t"] is None:
             turn["last_seen"] = (obs.t, obs.aspect)
         elif not seen and turn["lost_t"] is None and not obs.invalid:
@@ -289,9 +289,11 @@ class Controller:
                 return self._end_turn(obs.t)
         return self._spin(None)
 
-    def _end_turn(self, t: float, search: bool = False) -> Command:
+    def _end_turn(self, t: float) -> Command:
         self._turn = None
-        self._search_until = t + self.cfg.search_s if search else None
+        # the card not back after the turn (it never came back, or the turn ended edge-on: an
+        # occluded card misread the angle): spin on to find it, whenever it goes missing
+        self._search_until = t + self.cfg.search_s
         self.facing_away = not self.facing_away
         self.history.clear()
         self.missing = 0
