@@ -44,6 +44,10 @@ HOLD_WITHIN_M = 0.02
 CAMERAS = 16  # cameras (lenses, calibration) of a campaign; trial i uses camera i % CAMERAS
 RESET_P, BOOT_LOST_P = 0.02, 0.02  # chance of a board reset with its BOOT frame, without it
 TRUTH_GAP_M, TRUTH_GAP_REL = 0.10, 0.05  # driving on a depth this far from the truth is unsafe
+# the probe move (host.servo.acquire, at most probe_s at up to max_probe_duty) tests a sighting
+# it does not yet trust, maybe another robot's card: it is judged by where it goes (collisions,
+# the view, stale frames) and by this bound on its travel, not by the depth it tests
+PROBE_TRAVEL_M = 0.15
 
 
 @dataclass
@@ -147,10 +151,21 @@ class Judge:
         self.sim = sim
         self.last_valid = 0.0
         self.worst_gap = 0.0
+        self.probe_from: tuple[float, float] | None = None  # where the probe move began (m)
+        self.probe_travel = 0.0  # the longest probe move (m)
 
     def __call__(self, row: LogRow) -> str:
         if math.isfinite(row.depth_m) and not row.reason:
             self.last_valid = row.t
+        r = self.sim.world.robot
+        if row.phase == "probe":
+            self.probe_from = self.probe_from or (r.x_m, r.z_m)
+            travel = math.hypot(r.x_m - self.probe_from[0], r.z_m - self.probe_from[1])
+            self.probe_travel = max(self.probe_travel, travel)
+            if travel > PROBE_TRAVEL_M:
+                return f"the probe move went {travel * 100:.0f} cm on a sighting not yet trusted"
+            return _unsafe(self.sim, self.sim.source.t, self.sim.servo.stale_s)
+        self.probe_from = None
         gap = truth_gap(row)
         self.worst_gap = max(self.worst_gap, gap)
         if gap > TRUTH_GAP_M + TRUTH_GAP_REL * row.truth_depth_m:

@@ -61,6 +61,21 @@ def test_driving_on_a_depth_far_from_the_truth_is_unsafe() -> None:
     assert "marker depth" not in Judge(sim_with(1.26))(row(3.18, 1.26, reason="stale"))
 
 
+def test_a_probe_move_is_judged_by_its_travel_not_by_the_sighting_it_tests() -> None:
+    """The probe tests a sighting it does not trust yet (maybe another robot's card, which it
+    then leaves out): that sighting's depth is not held against it, its travel is."""
+    sim = sim_with(1.79)
+    judge = Judge(sim)
+    probe = row(1.43, 1.79)
+    probe.phase = "probe"
+    assert judge(probe) == ""  # the decoy at 1.43 m tested, the robot at 1.79 m
+    sim.world.robot.z_m = 1.79 - 0.10
+    assert judge(probe) == ""  # 10 cm: within the bound
+    sim.world.robot.z_m = 1.79 - 0.20
+    assert "the probe move went 20 cm" in judge(probe)
+    assert "drove on a marker depth" in Judge(sim_with(1.79))(row(1.43, 1.79))  # not a probe
+
+
 def test_a_run_that_does_not_settle_is_its_own_outcome(monkeypatch) -> None:
     """Not a safe stop: on today's main a trial out of time counted as "stopped"."""
     import host.sim.trials as trials
