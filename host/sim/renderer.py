@@ -295,7 +295,9 @@ class Renderer:
             # pixels come from the sensor's image of the bare scene with this noise field, and
             # only the pixels drawn over go through the sensor again
             out = self._bare(side, k).copy()
-            for r0, r1, c0, c1 in self._touched:
+            if self._touched:  # one rectangle round them all: the drawings overlap
+                r0, r1, c0, c1 = (f(t[i] for t in self._touched)
+                                  for i, f in enumerate((min, max, min, max)))
                 out[r0:r1, c0:c1] = self._sensor(img[r0:r1, c0:c1], side, k, (r0, r1, c0, c1))
             return out, disp
         if self.pitch_deg:  # the canvas's rows seen through the pitched rig
@@ -328,7 +330,8 @@ class Renderer:
         noise field k, white balance, distortion. Pixel by pixel the same arithmetic for a
         region as for the whole view."""
         cam = self.camera
-        img = img * cam.gain[side] + cam.bias[side]
+        img = np.multiply(img, cam.gain[side])  # a new array: img may be the caller's
+        np.add(img, cam.bias[side], out=img)
         if k is not None:
             noise = self._noise[k]
             img += noise if region is None else noise[region[0]:region[1], region[2]:region[3]]
@@ -336,9 +339,11 @@ class Renderer:
             img = img[..., None] * np.asarray(cam.white[side], np.float32)
         lens = self._lens[side]
         if lens is not None:
-            img = cv2.remap(img.astype(np.float32), lens[0], lens[1], cv2.INTER_LINEAR,
-                            borderMode=cv2.BORDER_REPLICATE)
-        return np.clip(np.rint(img), 0, 255).astype(np.uint8)
+            img = cv2.remap(img.astype(np.float32, copy=False), lens[0], lens[1],
+                            cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+        np.rint(img, out=img)
+        np.clip(img, 0, 255, out=img)
+        return img.astype(np.uint8)
 
     def _bare(self, side: int, k: int | None) -> np.ndarray:
         """The sensor's image (no pitch, flicker or lens) of the bare scene with noise field k,
