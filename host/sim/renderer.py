@@ -75,16 +75,23 @@ def lens_maps(world: World, k1: float) -> tuple[np.ndarray, np.ndarray] | None:
     return ideal[..., 0].copy(), ideal[..., 1].copy()
 
 
-def _coverage(qx: np.ndarray, qy: np.ndarray, t: float) -> np.ndarray:
-    """The fraction of each pixel's 4x4 samples with qx + qy <= t (float64, rows x columns),
-    the samples' terms given per column (qx, columns x 4) and per row (qy, rows x 4). A sum
-    rounded to float64 never decreases as a term grows, so a pixel whose largest terms pass is
-    covered and one whose least fail is not; only the pixels between count their samples."""
-    cov = ((qy.max(1)[:, None] + qx.max(1)[None, :]) <= t).astype(np.float64)
-    edge = (cov == 0) & ((qy.min(1)[:, None] + qx.min(1)[None, :]) <= t)
+def _coverage(qx: np.ndarray, qy: np.ndarray, ts: tuple[float, ...]) -> list[np.ndarray]:
+    """For each t of ts, the fraction of each pixel's 4x4 samples with qx + qy <= t (float64,
+    rows x columns), the samples' terms given per column (qx, columns x 4) and per row (qy,
+    rows x 4). A sum rounded to float64 never decreases as a term grows, so a pixel whose
+    largest terms pass is covered and one whose least fail is not; only the pixels between
+    count their samples."""
+    hi = qy.max(1)[:, None] + qx.max(1)[None, :]
+    lo = qy.min(1)[:, None] + qx.min(1)[None, :]
+    covs = [(hi <= t).astype(np.float64) for t in ts]
+    edge = np.zeros(hi.shape, bool)
+    for t in ts:
+        edge |= (hi > t) & (lo <= t)
     r, c = np.nonzero(edge)
-    cov[r, c] = np.count_nonzero(qx[c][:, None, :] + qy[r][:, :, None] <= t, axis=(1, 2)) / 16
-    return cov
+    samples = qx[c][:, None, :] + qy[r][:, :, None]
+    for t, cov in zip(ts, covs):
+        cov[r, c] = np.count_nonzero(samples <= t, axis=(1, 2)) / 16
+    return covs
 
 
 class Renderer:
@@ -267,7 +274,7 @@ class Renderer:
         sub = (np.arange(4) + 0.5) / 4 - 0.5
         qy = ((np.arange(r0, r1)[:, None] + sub - v) / ry) ** 2  # rows x 4 sub-rows
         qx = ((np.arange(c0, c1)[:, None] + sub - u) / rx) ** 2  # columns x 4 sub-columns
-        ring_cov, disc_cov = (_coverage(qx, qy, t) for t in (ring * ring, 1.0))
+        ring_cov, disc_cov = _coverage(qx, qy, (ring * ring, 1.0))
         patch = image[r0:r1, c0:c1]
         shown = ~(disp[r0:r1, c0:c1] > d + NEARER_PX)
         light = ring_cov - disc_cov
