@@ -352,9 +352,17 @@ class Renderer:
         if k is not None:
             noise = self._noise[k]
             img += noise if region is None else noise[region[0]:region[1], region[2]:region[3]]
+        lens = self._lens[side]
+        if lens is None and img.dtype == np.float32:
+            # OpenCV's conversion to uint8 rounds half to even and saturates, as rint and clip
+            # do, and scales in float32 as numpy does: the same image, without the temporaries
+            cv2.max(img, 0.0, dst=img)  # then |x w| is x w, and what was below 0 is 0 still
+            if not cam.white:
+                return cv2.convertScaleAbs(img)
+            return cv2.merge([cv2.convertScaleAbs(img, alpha=float(np.float32(c)))
+                              for c in cam.white[side]])
         if cam.white:
             img = img[..., None] * np.asarray(cam.white[side], np.float32)
-        lens = self._lens[side]
         if lens is not None:
             img = cv2.remap(img.astype(np.float32, copy=False), lens[0], lens[1],
                             cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
