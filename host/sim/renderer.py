@@ -366,6 +366,8 @@ class Renderer:
         if lens is not None:
             img = cv2.remap(img.astype(np.float32, copy=False), lens[0], lens[1],
                             cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+            cv2.max(img, 0.0, dst=img)  # rounded and saturated as above
+            return cv2.convertScaleAbs(img)
         np.rint(img, out=img)
         np.clip(img, 0, 255, out=img)
         return img.astype(np.uint8)
