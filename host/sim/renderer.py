@@ -9,6 +9,12 @@ anti-aliased marker at its exact sub-pixel position. A rig knocked since its cal
 modulates each row by the light at the time a rolling shutter reads it. Lens distortion maps
 each raw pixel to where the ideal (rectified) camera saw it, so a calibration on rendered
 chessboards recovers it as it would a real lens.
+
+Speed: a sensor's grey level is a function of the ideal view's at that pixel alone, so with no
+pitch, flicker or lens the bare scene's sensor image is made once per layout and noise field,
+and each view sends only the rectangles drawn over (robot, marker, blur, people) through the
+sensor again; the images are bit-identical to the full computation
+(tests/sim/test_render_speedup.py).
 """
 
 from __future__ import annotations
@@ -69,6 +75,25 @@ def lens_maps(world: World, k1: float) -> tuple[np.ndarray, np.ndarray] | None:
     return ideal[..., 0].copy(), ideal[..., 1].copy()
 
 
+def _coverage(qx: np.ndarray, qy: np.ndarray, ts: tuple[float, ...]) -> list[np.ndarray]:
+    """For each t of ts, the fraction of each pixel's 4x4 samples with qx + qy <= t (float64,
+    rows x columns), the samples' terms given per column (qx, columns x 4) and per row (qy,
+    rows x 4). A sum rounded to float64 never decreases as a term grows, so a pixel whose
+    largest terms pass is covered and one whose least fail is not; only the pixels between
+    count their samples."""
+    hi = qy.max(1)[:, None] + qx.max(1)[None, :]
+    lo = qy.min(1)[:, None] + qx.min(1)[None, :]
+    covs = [(hi <= t).astype(np.float64) for t in ts]
+    edge = np.zeros(hi.shape, bool)
+    for t in ts:
+        edge |= (hi > t) & (lo <= t)
+    r, c = np.nonzero(edge)
+    samples = qx[c][:, None, :] + qy[r][:, :, None]
+    for t, cov in zip(ts, covs):
+        cov[r, c] = np.count_nonzero(samples <= t, axis=(1, 2)) / 16
+    return covs
+
+
 class Renderer:
     def __init__(self, world: World, camera: CameraFaults = CameraFaults(), seed: int = 0
                  ) -> None:
@@ -83,6 +108,9 @@ class Renderer:
         self._last_noise = [-1, -1]  # the noise field each sensor got last
         self._row0 = 0  # rows of the canvas above the view's first (a pitched rig sees them)
         self.flicker: Flicker | None = None
+        self._touched: list[tuple[int, int, int, int]] = []  # rows, columns drawn this view
+        self._bare_key: tuple | None = None  # the layout _bare_images are of
+        self._bare_images: dict[tuple[int, int | None], np.ndarray] = {}
         self._lens = [lens_maps(world, k1) for k1 in camera.distortion]
         w, h = world.size
         # sensor noise: a bank of independent fields, one drawn at random per view (drawing a
@@ -172,7 +200,7 @@ class Renderer:
         half_w = abs(math.cos(r.theta)) * r.body_width_m / 2 + abs(math.sin(r.theta)) * 0.08
         x0, y0 = self._project(r.x_m - half_w, r.body_height_m, r.z_m)
         x1, y1 = self._project(r.x_m + half_w, 0.02, r.z_m)
-        before = image.copy() if max(abs(blur_px[0]), abs(blur_px[1])) >= 0.5 else None
+        blurred = max(abs(blur_px[0]), abs(blur_px[1])) >= 0.5
         self._paint(image, disp, (x0 - shift * d, y0, x1 - shift * d, y1), d, self._body_tex)
         u, v = self._project(r.x_m, r.marker_height_m, r.z_m)
         ry = g.focal_px * r.marker_radius_m / r.z_m
@@ -189,12 +217,11 @@ class Renderer:
             box = (left - shift * dp, v - 3 * ry, left + 2 * ring * r.occlusion - shift * dp,
                    v + 3 * ry)
             self._paint(image, disp, box, dp, self._body_tex)
-        if before is not None:
-            self._blur(image, before, (min(x0, u - 2 * ry) - shift * d, min(y0, v - 2 * ry),
+        if blurred:
+            self._blur(image, (min(x0, u - 2 * ry) - shift * d, min(y0, v - 2 * ry),
                                        max(x1, u + 2 * ry) - shift * d, y1), blur_px)
 
-    @staticmethod
-    def _blur(image: np.ndarray, before: np.ndarray, box, blur_px) -> None:
+    def _blur(self, image: np.ndarray, box, blur_px) -> None:
         """Motion blur over the robot's region: the image averaged along its motion (px over
         the exposure); the background it passes over takes part, as on a sensor."""
         h, w = image.shape
@@ -209,11 +236,11 @@ class Renderer:
             s = i / (2 * n) - 0.5
             k[int(round(n + s * blur_px[1])), int(round(n + s * blur_px[0]))] += 1.0
         k /= k.sum()
+        self._touched.append((r0, r1, c0, c1))
         region = image[r0:r1, c0:c1]
         region[:] = cv2.filter2D(region, -1, k, borderType=cv2.BORDER_REPLICATE)
 
-    @staticmethod
-    def _paint(image, disp, box, d, texture: np.ndarray | None) -> None:
+    def _paint(self, image, disp, box, d, texture: np.ndarray | None) -> None:
         """A surface at disparity d over box (texture, or a uniform grey 60), where the scene
         is not nearer."""
         h, w = image.shape
@@ -222,17 +249,19 @@ class Renderer:
         r0, r1 = max(0, int(math.ceil(y0))), min(h, int(math.ceil(y1)))
         if c0 >= c1 or r0 >= r1:
             return
+        self._touched.append((r0, r1, c0, c1))
         shown = ~(disp[r0:r1, c0:c1] > d + NEARER_PX)
-        if texture is not None:
-            ys, xs = np.mgrid[r0:r1, c0:c1]
-            surface = texture[(ys - r0) % texture.shape[0], (xs - c0) % texture.shape[1]]
-            image[r0:r1, c0:c1][shown] = surface[shown]
+        if texture is not None:  # the texture from its corner, repeated where the box is larger
+            th, tw = texture.shape
+            surface = texture[:r1 - r0, :c1 - c0]
+            if r1 - r0 > th or c1 - c0 > tw:
+                surface = texture[np.arange(r1 - r0) % th][:, np.arange(c1 - c0) % tw]
+            np.copyto(image[r0:r1, c0:c1], surface, where=shown)
         else:
             image[r0:r1, c0:c1][shown] = 60.0
         disp[r0:r1, c0:c1][shown] = d
 
-    @staticmethod
-    def _marker(image, disp, u, v, rx, ry, d, ring) -> None:
+    def _marker(self, image, disp, u, v, rx, ry, d, ring) -> None:
         """Dark disc in a light ring, anti-aliased by 4x4 supersampling of each pixel."""
         if rx < 0.5:
             return
@@ -241,12 +270,11 @@ class Renderer:
         r0, r1 = max(0, int(v - ry * ring) - 1), min(h, int(v + ry * ring) + 2)
         if c0 >= c1 or r0 >= r1:
             return
+        self._touched.append((r0, r1, c0, c1))
         sub = (np.arange(4) + 0.5) / 4 - 0.5
-        ys = np.arange(r0, r1)[:, None, None, None] + sub[None, None, :, None]
-        xs = np.arange(c0, c1)[None, :, None, None] + sub[None, None, None, :]
-        q = ((xs - u) / rx) ** 2 + ((ys - v) / ry) ** 2
-        ring_cov = (q <= ring * ring).mean(axis=(2, 3))
-        disc_cov = (q <= 1.0).mean(axis=(2, 3))
+        qy = ((np.arange(r0, r1)[:, None] + sub - v) / ry) ** 2  # rows x 4 sub-rows
+        qx = ((np.arange(c0, c1)[:, None] + sub - u) / rx) ** 2  # columns x 4 sub-columns
+        ring_cov, disc_cov = _coverage(qx, qy, (ring * ring, 1.0))
         patch = image[r0:r1, c0:c1]
         shown = ~(disp[r0:r1, c0:c1] > d + NEARER_PX)
         light = ring_cov - disc_cov
@@ -267,6 +295,7 @@ class Renderer:
         img, disp = (a.copy() for a in static)
         world = self.world
         self._row0 = (img.shape[0] - world.size[1]) // 2
+        self._touched = []
         things: list[tuple[float, object]] = [(p.z_m, p) for p in world.people]
         things += [(r.z_m, r) for r in world.decoys]
         if with_robot:
@@ -277,6 +306,17 @@ class Renderer:
             else:
                 blur = blur_px if thing is world.robot else (0.0, 0.0)
                 self._draw_robot(img, disp, float(side), blur, thing)
+        k = self._noise_field(side)
+        if not self.pitch_deg and self.flicker is None and self._lens[side] is None:
+            # each pixel's grey level is a function of the ideal view's there alone: the scene's
+            # pixels come from the sensor's image of the bare scene with this noise field, and
+            # only the pixels drawn over go through the sensor again
+            out = self._bare(side, k).copy()
+            if self._touched:  # one rectangle round them all: the drawings overlap
+                r0, r1, c0, c1 = (f(t[i] for t in self._touched)
+                                  for i, f in enumerate((min, max, min, max)))
+                out[r0:r1, c0:c1] = self._sensor(img[r0:r1, c0:c1], side, k, (r0, r1, c0, c1))
+            return out, disp
         if self.pitch_deg:  # the canvas's rows seen through the pitched rig
             hom = rotation_homography(world, self.pitch_deg) @ np.array(
                 [[1, 0, 0], [0, 1, -self._row0], [0, 0, 1]], np.float64)
@@ -287,22 +327,61 @@ class Renderer:
         if self.flicker is not None:
             t = world.t if t_s is None else t_s
             img = img * self.flicker.gains(t, side, img.shape[0])[:, None]
+        return self._sensor(img, side, k), disp
+
+    def _noise_field(self, side: int) -> int | None:
+        """The bank's noise field for this view: never the last field again (a live sensor
+        never repeats its image exactly; a repeat is what a frozen one does)."""
+        if self._noise is None:
+            return None
+        k = int(self.rng.integers(len(self._noise)))
+        if k == self._last_noise[side]:
+            k = (k + 1) % len(self._noise)
+        self._last_noise[side] = k
+        return k
+
+    def _sensor(self, img: np.ndarray, side: int, k: int | None,
+                region: tuple[int, int, int, int] | None = None) -> np.ndarray:
+        """The ideal view's grey levels (float32; or a region of them: rows r0:r1, columns
+        c0:c1) as the sensor and lens turn them into the image (uint8): gain and black level,
+        noise field k, white balance, distortion. Pixel by pixel the same arithmetic for a
+        region as for the whole view."""
         cam = self.camera
-        img = img * cam.gain[side] + cam.bias[side]
-        if self._noise is not None:  # never the last field again: a live sensor never
-            # repeats its image exactly (a repeat is what a frozen one does)
-            k = int(self.rng.integers(len(self._noise)))
-            if k == self._last_noise[side]:
-                k = (k + 1) % len(self._noise)
-            self._last_noise[side] = k
-            img += self._noise[k]
+        img = np.multiply(img, cam.gain[side])  # a new array: img may be the caller's
+        np.add(img, cam.bias[side], out=img)
+        if k is not None:
+            noise = self._noise[k]
+            img += noise if region is None else noise[region[0]:region[1], region[2]:region[3]]
+        lens = self._lens[side]
+        if lens is None and img.dtype == np.float32:
+            # OpenCV's conversion to uint8 rounds half to even and saturates, as rint and clip
+            # do, and scales in float32 as numpy does: the same image, without the temporaries
+            cv2.max(img, 0.0, dst=img)  # then |x w| is x w, and what was below 0 is 0 still
+            if not cam.white:
+                return cv2.convertScaleAbs(img)
+            return cv2.merge([cv2.convertScaleAbs(img, alpha=float(np.float32(c)))
+                              for c in cam.white[side]])
         if cam.white:
             img = img[..., None] * np.asarray(cam.white[side], np.float32)
-        lens = self._lens[side]
         if lens is not None:
-            img = cv2.remap(img.astype(np.float32), lens[0], lens[1], cv2.INTER_LINEAR,
-                            borderMode=cv2.BORDER_REPLICATE)
-        return np.clip(np.rint(img), 0, 255).astype(np.uint8), disp
+            img = cv2.remap(img.astype(np.float32, copy=False), lens[0], lens[1],
+                            cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+            cv2.max(img, 0.0, dst=img)  # rounded and saturated as above
+            return cv2.convertScaleAbs(img)
+        np.rint(img, out=img)
+        np.clip(img, 0, 255, out=img)
+        return img.astype(np.uint8)
+
+    def _bare(self, side: int, k: int | None) -> np.ndarray:
+        """The sensor's image (no pitch, flicker or lens) of the bare scene with noise field k,
+        made once per scene layout."""
+        self._static_views()
+        if self._bare_key != self._static_key:
+            self._bare_images, self._bare_key = {}, self._static_key
+        key = (side, k)
+        if key not in self._bare_images:
+            self._bare_images[key] = self._sensor(self._static[side][0], side, k)
+        return self._bare_images[key]
 
     def image_velocity(self) -> tuple[float, float]:
         """The marker's motion in the left image, px/s, from the robot's velocity."""
