@@ -156,31 +156,3 @@ def test_what_the_reference_showed_is_not_new() -> None:
     assert watch(world, left, right, ref, reach=0.3) is None
     grazed = watch(world, left, right, None, reach=0.3)
     assert grazed is not None and abs(grazed.depth_m - 1.2) < 0.04
-
-
-def test_in_a_faulty_trial_the_extent_reaches_the_side_the_first_level_missed() -> None:
-    """Trial 5 of seed 2 (lenses, exposure, calibration from rendered chessboards): the
-    reference's target region is 35 px of a box whose lane-side edge is at column 105.6 (its
-    region ends at 58: the keep-out 16 cm short); its extent ends within 2 px of the edge."""
-    import warnings
-
-    from host.servo.perception import reference_target
-    from host.sim.run import simulation
-    from host.sim.trials import trial_setup
-
-    setup = trial_setup(2, 5, (320, 240), PARAMS)
-    with simulation(setup, reference=False) as sim:
-        disps = []
-        for _ in range(5):
-            f = sim.source.read()
-            disps.append(compute_disparity(f.left, match_exposure(f.left, f.right),
-                                           sim.servo.params))
-        target, floor = reference_target(disps, 768)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            median = np.nanmedian(np.stack(disps), axis=0)
-        full = object_extent(without_floor(median, floor), target)
-        box, g = sim.world.boxes[0], sim.world.geometry
-    edge = g.cx + g.focal_px * box.x1_m / box.z_m
-    assert target.bbox[0] + target.bbox[2] < edge - 40
-    assert abs(full.bbox[0] + full.bbox[2] - edge) <= 2
