@@ -205,6 +205,8 @@ ROWS = [
     # the simulated Uno's flash: saved where it can be, and only for --uno
     (["emulate", "--uno", "--flash", "{tmp}/nodir/f.bin"], "--flash {tmp}/nodir/f.bin: no such"),
     (["emulate", "--flash", "{tmp}/f.bin"], "--flash is the simulated Uno's flash"),
+    (["servo", "--sim", "--flash", "{tmp}/f.bin"], "--flash is the simulated Uno's flash: it goes "
+     "with --robot uno"),
     # images of two depths; ground truth PFMs and calib.txt that are wrong in their own ways
     (["disparity", "{l16}", "{l}", "-o", "{tmp}/o.png"], "l16.png: a 16-bit image"),
     (["eval", "{pfm_abc}"], "PFM size 'abc 5' is not two positive integers"),

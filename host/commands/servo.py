@@ -34,6 +34,8 @@ from host.servo.loop import Servo
 from host.servo.report import plot_run, write_csv
 from host.servo_run import ENDED, NOT_SETTLED, Rules, run_servo
 
+UNO_FLASH = Path("uno-flash.bin")  # --robot uno's flash file when --flash is not given
+
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("servo", help="servo the robot to the nearest object's depth")
@@ -44,9 +46,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="--sim: the robot in the simulated world: the firmware's core built "
                         "natively (in lockstep), its AVR binary in simavr, or a simulated Uno "
                         "running what was flashed into --flash (both in real time)")
-    p.add_argument("--flash", type=Path, default=Path("uno-flash.bin"), metavar="FILE",
+    p.add_argument("--flash", type=Path, metavar="FILE",
                    help="--robot uno: the board's flash, as `host emulate --uno --flash FILE` "
-                        "and an upload left it (default %(default)s)")
+                        f"and an upload left it (default {UNO_FLASH})")
     p.add_argument("--log", type=Path, metavar="run.csv", help="write the run's log")
     p.add_argument("--plot", type=Path, metavar="run.png",
                    help="plot trajectory and commands (with --trials: the campaign's summary)")
@@ -137,6 +139,8 @@ class _Status:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.flash is not None and args.robot != "uno":
+        raise HostError("--flash is the simulated Uno's flash: it goes with --robot uno")
     if args.robot != "emulator" and not args.sim:
         raise HostError(f"--robot {args.robot} puts a simulated board in the simulated world: "
                         f"it needs --sim")
@@ -253,10 +257,11 @@ def _avr_board(args):
     if args.robot == "uno":
         from host.emulator.uno import SimulatedUno
 
-        if not args.flash.is_file():
-            raise HostError(f"--flash {args.flash} not found: flash the Uno first (host emulate "
-                            f"--uno --flash {args.flash}, then make flash PORT=...)")
-        return SimulatedUno(args.flash)
+        flash = args.flash or UNO_FLASH
+        if not flash.is_file():
+            raise HostError(f"--flash {flash} not found: flash the Uno first (host emulate "
+                            f"--uno --flash {flash}, then make flash PORT=...)")
+        return SimulatedUno(flash)
     from host.emulator.simavr import SimavrPty
 
     out = build.ROOT / "build" / "simavr"
