@@ -27,7 +27,7 @@ from host.commands.servo_outcome import outcome, replay_outcome
 from host.commands.view import add_view_option, hold_view, open_view
 from host.errors import HostError, NotReached, RecordingEnded
 from host.files import check_folder, check_output
-from host.link.client import RobotLink
+from host.link.client import SERVO_DRIVE_BUDGET_S, RobotLink
 from host.record import add_record_options, check_record, record_servo
 from host.servo.controller import ControlConfig
 from host.servo.loop import Servo
@@ -177,7 +177,8 @@ def run(args: argparse.Namespace) -> int:
 
             service = stack.enter_context(PtyService(Emulator(_link_faults(args))))
         # the port first: a wrong one fails before a camera is opened
-        link = stack.enter_context(RobotLink(service.path if service else args.port))
+        link = stack.enter_context(RobotLink(service.path if service else args.port,
+                                             drive_budget_s=SERVO_DRIVE_BUDGET_S))
         source = stack.enter_context(open_source(args))
         geometry = source_geometry(args, source)
         clock = getattr(source, "clock", time.monotonic)  # a bag's own clock (its stamps)

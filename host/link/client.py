@@ -58,6 +58,9 @@ def explain_reset(cause: int) -> str:
         return f"cause {cause} (not in this host's protocol)"
 
 
+SERVO_DRIVE_BUDGET_S = 0.2  # s: a servo's drive is two tries of the default reply timeout
+
+
 class RobotLink:
     """A session with the robot over a serial port (a device path or a pyserial URL) or an
     open Port (host.link.port); rng numbers the frames and draws the HELLO nonces (seed it for
@@ -65,7 +68,7 @@ class RobotLink:
 
     def __init__(self, port: str | Port, *, baud: int = gen.BAUD, reply_timeout_s: float = 0.1,
                  retries: int = 8, handshake_s: float = 3.0, keepalive_s: float = 0.08,
-                 status_s: float = 0.5, drive_budget_s: float | None = 0.2,
+                 status_s: float = 0.5, drive_budget_s: float | None = None,
                  expected_hash: int = gen.SCHEMA_HASH,
                  rng: random.Random | None = None) -> None:
         self.port = port if isinstance(port, str) else getattr(port, "name", "the robot's line")
@@ -73,7 +76,8 @@ class RobotLink:
         self.status_s = status_s  # how often drive() first checks the robot's STATUS; 0: never
         # a drive() not confirmed within this long (its STATUS check included) is given up and
         # the robot sent STOP instead: while the host resends, the robot runs on the command
-        # before, on an observation that grows old (None: the retries alone bound it)
+        # before, on an observation that grows old (None: the retries alone bound it; the
+        # servo's links use SERVO_DRIVE_BUDGET_S)
         self.drive_budget_s = drive_budget_s
         self.unconfirmed = 0  # drives given up for a STOP (drive_budget_s)
         self.baud = baud

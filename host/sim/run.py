@@ -15,7 +15,7 @@ from typing import Any
 from host.camera.calibration import Rectifier
 from host.emulator.emulator import Emulator
 from host.emulator.lockstep import LockstepLine
-from host.link.client import RobotLink
+from host.link.client import SERVO_DRIVE_BUDGET_S, RobotLink
 from host.servo.controller import ControlConfig
 from host.servo.loop import Servo
 from host.servo_run import Rules, run_servo
@@ -89,6 +89,7 @@ def simulation(setup: Setup = Setup(), reference: bool = True) -> Iterator[SimRu
                                                                    lambda: source.now_ms)
     reply_timeout_s = max(0.2, setup.reply_timeout_s) if setup.board else setup.reply_timeout_s
     with RobotLink(port, retries=setup.retries, reply_timeout_s=reply_timeout_s,
+                   drive_budget_s=max(SERVO_DRIVE_BUDGET_S, 2 * reply_timeout_s),
                    rng=random.Random(setup.seed)) as link:
         geometry = world.geometry
         if any(faults.camera.distortion):  # rectify as a user would: with a calibration
