@@ -59,7 +59,9 @@ def run_servo(servo: Servo, rules: Rules, clock: Callable[[], float],
         why = watch(row) if watch is not None else ""
         if why:
             return End(UNSAFE, why)
-        if servo.stop_reason or row.phase == "stop":
+        # only on the step that sent STOP: a stop requested from another thread (the view's
+        # STOP) while a step was deciding takes effect at the next step, which sends it
+        if row.phase == "stop":
             return End(STOPPED, servo.stop_reason or row.reason)
         lost_since = (lost_since if lost_since is not None else row.t) \
             if row.phase == "lost" else None

@@ -1,0 +1,33 @@
+"""The one run driver (host.servo_run): a run ends on the step that sent STOP, never on the step
+during which another thread (the view's STOP button) asked for it while a drive went out."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+from host.servo_run import STOPPED, Rules, run_servo
+
+
+class RacedServo:
+    """A servo whose first step drives while a STOP is requested meanwhile; the next step sends
+    the STOP (as Servo.step does: the request is read once, at the decision)."""
+
+    def __init__(self) -> None:
+        self.stop_reason, self.sent = "", []
+
+    def step(self, truth: float) -> SimpleNamespace:
+        phase = "stop" if self.stop_reason else "drive"
+        self.sent.append(phase)
+        if phase == "drive":
+            self.stop_reason = "STOP pressed in the view"  # arrives while the drive goes out
+        return SimpleNamespace(phase=phase, t=len(self.sent) * 0.033, reason=self.stop_reason)
+
+    def held_for(self, seconds: float) -> bool:
+        return False
+
+
+def test_a_stop_requested_during_a_drive_ends_the_run_after_the_stop_is_sent() -> None:
+    servo = RacedServo()
+    end = run_servo(servo, Rules(settle_s=0), clock=lambda: 0.0)
+    assert (end.how, end.reason) == (STOPPED, "STOP pressed in the view")
+    assert servo.sent == ["drive", "stop"]  # the run did not end with the drive the last word
