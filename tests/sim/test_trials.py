@@ -8,7 +8,6 @@ import io
 import json
 import math
 import os
-import shutil
 import signal
 import subprocess
 import sys
@@ -24,6 +23,7 @@ from host.sim.trial_stats import summary, upper_bound, wilson
 from host.sim.trials import Judge, Trial, _unsafe
 from host.sim.world import World
 from host.stereo.params import MatcherParams
+from tests.netns import loopback_only
 
 PARAMS = MatcherParams(block_size=9, num_disparities=48, border="clip")
 
@@ -190,23 +190,12 @@ def test_resume_refuses_another_campaigns_file(tmp_path) -> None:
     assert r.stderr.count("\n") == 1
 
 
-def _loopback_only() -> list[str]:
-    """The command prefix that runs a shell inside a loopback-only network namespace."""
-    if shutil.which("unshare") is None or shutil.which("ip") is None:
-        pytest.skip("unshare or ip is not installed")
-    probe = subprocess.run(["unshare", "-n", "sh", "-c", "ip link set lo up"],
-                           capture_output=True, text=True)
-    if probe.returncode:
-        pytest.skip(f"unshare -n is not permitted here: {probe.stderr.strip()}")
-    return ["unshare", "-n", "sh", "-c"]
-
-
 def test_a_trial_on_ray_is_the_trial_run_alone(tmp_path) -> None:
     """--trial-index reproduces a trial whichever backend ran it: Ray (a local cluster in a
     loopback-only namespace) and one process give the same bytes (also the calibration of the
     trial's lenses, whose last bits depend on BLAS's thread count)."""
     pytest.importorskip("ray", reason="Ray is not installed (pip install 'stereo-servo[ray]')")
-    prefix = _loopback_only()
+    prefix = loopback_only()
     plan = ["--trials", "40", "--seed", "5", "--trial-index", "37"]  # faulty: lenses too
     env = os.environ | {"RAY_USAGE_STATS_ENABLED": "0"}
     alone = subprocess.run(_host(*plan, "--workers", "1", "--json", str(tmp_path / "a.json")),

@@ -98,19 +98,3 @@ def test_match_histogram_undoes_a_gain_and_a_gamma() -> None:
         assert np.abs(changed.astype(int) - img).mean() > 10
     # the table comes from the samples given: a sample identical to the reference's is identity
     np.testing.assert_array_equal(match_histogram(img, img), img)
-
-
-def test_sgm_defaults_give_the_same_map_on_one_and_two_threads() -> None:
-    import numba
-
-    scene = synthetic_scene(seed=3, noise=0.5)
-    p = MatcherParams.for_matcher("sgm").replace(num_disparities=48)
-    before = numba.get_num_threads()
-    try:
-        maps = []
-        for threads in (1, 2):
-            numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
-            maps.append(compute_disparity(scene.left, scene.right, p))
-    finally:
-        numba.set_num_threads(before)
-    np.testing.assert_array_equal(maps[0], maps[1])

@@ -111,10 +111,13 @@ def test_five_path_lower_stripe_starts_its_paths_from_above_overlap_rows_up() ->
     np.testing.assert_array_equal(total[upper:], below)
 
 
-@pytest.mark.parametrize("paths", [8, 5, 4])
-def test_sgm_gives_the_same_map_on_one_and_two_threads(paths: int) -> None:
+@pytest.mark.parametrize("p", [
+    *(SGM.replace(num_disparities=48, paths=n, lr_check=1.0, uniqueness_ratio=5)
+      for n in (8, 5, 4)),
+    MatcherParams.for_matcher("sgm").replace(num_disparities=48),  # --matcher sgm's defaults
+], ids=["8 paths", "5 paths", "4 paths", "defaults"])
+def test_sgm_gives_the_same_map_on_one_and_two_threads(p: MatcherParams) -> None:
     scene = synthetic_scene(seed=3, noise=0.5)
-    p = SGM.replace(num_disparities=48, paths=paths, lr_check=1.0, uniqueness_ratio=5)
     before = numba.get_num_threads()
     try:
         maps = []

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import json
 import os
-import shutil
 import signal
 import subprocess
 import sys
@@ -16,23 +15,13 @@ import numpy as np
 import pytest
 
 from host.stereo.synthetic import synthetic_scene
+from tests.netns import loopback_only
 
 pytest.importorskip("ray", reason="Ray is not installed (pip install 'stereo-servo[ray]')")
 
 
-def _loopback_only() -> list[str]:
-    """The command prefix that runs a shell inside a loopback-only network namespace."""
-    if shutil.which("unshare") is None or shutil.which("ip") is None:
-        pytest.skip("unshare or ip is not installed")
-    probe = subprocess.run(["unshare", "-n", "sh", "-c", "ip link set lo up"],
-                           capture_output=True, text=True)
-    if probe.returncode:
-        pytest.skip(f"unshare -n is not permitted here: {probe.stderr.strip()}")
-    return ["unshare", "-n", "sh", "-c"]
-
-
 def test_ray_backend_matches_the_local_run(tmp_path: Path) -> None:
-    prefix = _loopback_only()
+    prefix = loopback_only()
     for i, d in enumerate((16,)):
         s = synthetic_scene(seed=i, width=120, height=90, max_disp=d, noise=2.0)
         scene = tmp_path / f"s{i}"
