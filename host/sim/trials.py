@@ -152,7 +152,6 @@ class Judge:
         self.last_valid = 0.0
         self.worst_gap = 0.0
         self.probe_from: tuple[float, float] | None = None  # where the probe move began (m)
-        self.probe_travel = 0.0  # the longest probe move (m)
 
     def __call__(self, row: LogRow) -> str:
         if math.isfinite(row.depth_m) and not row.reason:
@@ -161,10 +160,9 @@ class Judge:
         if row.phase == "probe":
             self.probe_from = self.probe_from or (r.x_m, r.z_m)
             travel = math.hypot(r.x_m - self.probe_from[0], r.z_m - self.probe_from[1])
-            self.probe_travel = max(self.probe_travel, travel)
             if travel > PROBE_TRAVEL_M:
                 return f"the probe move went {travel * 100:.0f} cm on a sighting not yet trusted"
-            return _unsafe(self.sim, self.sim.source.t, self.sim.servo.stale_s)
+            return _unsafe(self.sim, self.last_valid, self.sim.servo.stale_s)
         self.probe_from = None
         gap = truth_gap(row)
         self.worst_gap = max(self.worst_gap, gap)

@@ -74,6 +74,11 @@ def test_a_probe_move_is_judged_by_its_travel_not_by_the_sighting_it_tests() -> 
     sim.world.robot.z_m = 1.79 - 0.20
     assert "the probe move went 20 cm" in judge(probe)
     assert "drove on a marker depth" in Judge(sim_with(1.79))(row(1.43, 1.79))  # not a probe
+    # a probe is no exemption from the stale limit: driving 0.5 s past the last sighting
+    blind = Judge(sim_with(1.79, t=5.5))
+    unseen = row(math.nan, 1.79)
+    unseen.phase = "probe"
+    assert "without a valid observation" in blind(unseen)
 
 
 def test_a_run_that_does_not_settle_is_its_own_outcome(monkeypatch) -> None:
