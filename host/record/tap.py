@@ -17,6 +17,7 @@ from host.camera.source import StereoFrame, StereoSource
 from host.link import protocol_gen as gen
 from host.record import messages as m
 from host.record.writer import Message, Recorder
+from host.servo.loop import marker_band
 from host.servo.snapshot import Snapshot
 
 Search = Callable[[Snapshot], tuple[float, float]]  # the disparity range a map was searched in
@@ -77,7 +78,7 @@ def servo_range(servo: Any) -> Search:
         if snap.disparity_y0 == 0 and snap.disparity is not None and \
                 snap.disparity.shape[0] == snap.left.shape[0] or snap.marker is None:
             return whole(snap)
-        p = servo._band_params(snap.marker.disparity)
+        p = marker_band(servo.params, snap.marker.disparity)
         return float(p.min_disparity), float(p.min_disparity + p.num_disparities)
     return search
 

@@ -62,6 +62,12 @@ STILL_REASON = "the marker did not move while the robot drove"
 MAX_FLIPS = 2  # heading corrections in a run before "against" ends it
 
 
+def marker_band(params: MatcherParams, d: float) -> MatcherParams:
+    """The matcher's search range around a marker's disparity d (16 px wide): what the servo
+    matches over the marker when it does not match the whole map."""
+    return params.replace(min_disparity=max(0, int(d) - 8), num_disparities=16)
+
+
 @dataclass(frozen=True)
 class ServoConfig:
     marker: str = "disc"  # or "aruco"
@@ -247,14 +253,10 @@ class Servo:
 
     # --------------------------------------------------------------------- perception
 
-    def _band_params(self, d: float) -> MatcherParams:
-        """The matcher's search range around the marker's disparity d (16 px wide)."""
-        return self.params.replace(min_disparity=max(0, int(d) - 8), num_disparities=16)
-
     def _robot_disparity(self, frame: StereoFrame, pair: MarkerPair
                          ) -> tuple[float, np.ndarray, tuple[int, int]]:
         """Block-matching disparity over the marker (a band of rows, or the whole map)."""
-        params = self._band_params(pair.disparity)
+        params = marker_band(self.params, pair.disparity)
         if self.cfg.full_map:
             disp = compute_disparity(frame.left, frame.right, params)
             return block_disparity(disp, pair.left), disp, (0, frame.left.shape[0])
