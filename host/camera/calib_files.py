@@ -1,5 +1,6 @@
-"""Calibration files: OpenCV FileStorage YAML (host calibrate --out) and ROS camera_info YAML
-(one file per camera, as camera_calibration and stereo_image_proc read and write them).
+"""A stereo calibration and its files: OpenCV FileStorage YAML (host calibrate --out) and ROS
+camera_info YAML (one file per camera, as camera_calibration and stereo_image_proc read and
+write them).
 
 Every way a file can be wrong (missing, not text, a YAML syntax error, missing or misshapen
 matrices, a bad image_size) is one CameraError line naming the file, never a traceback.
@@ -11,15 +12,18 @@ from __future__ import annotations
 import math
 import os
 import re
+from dataclasses import dataclass
 from pathlib import Path
 
 import cv2
 import numpy as np
 import yaml
 
-from host.camera.calibration import MATRICES, Calibration, Geometry
+from host.camera.geometry import Geometry
 from host.camera.source import CameraError
 from host.files import write_text_atomic
+
+MATRICES = ("M1", "D1", "M2", "D2", "R", "T", "E", "F", "R1", "R2", "P1", "P2", "Q")
 
 # shapes (rows, cols); None: any count (distortion has 4, 5, 8 ... coefficients)
 SHAPES: dict[str, tuple[int | None, int | None]] = {
@@ -28,6 +32,36 @@ SHAPES: dict[str, tuple[int | None, int | None]] = {
     "P2": (3, 4), "Q": (4, 4)}
 OLD_NAMES = {"M1": "K1", "M2": "K2"}  # files written before the sample's names were used
 MM_PER_M = 1000.0
+
+
+@dataclass
+class Calibration:
+    """A stereo calibration: matrices named as in OpenCV's stereo_calib sample (MATRICES)."""
+
+    size: tuple[int, int]  # (width, height) px
+    mats: dict[str, np.ndarray]  # MATRICES
+    rms: float  # px, reprojection RMS of the stereo fit (NaN when not known, e.g. from ROS)
+    epipolar_rms: float  # px, row difference of rectified corners
+
+    @property
+    def baseline_mm(self) -> float:
+        return float(np.linalg.norm(self.mats["T"]))
+
+    @property
+    def geometry(self) -> Geometry:
+        p1, p2 = self.mats["P1"], self.mats["P2"]
+        return Geometry(float(p1[0, 0]), abs(float(p2[0, 3] / p2[0, 0])) / 1000.0,
+                        float(p1[0, 2]), float(p1[1, 2]))
+
+    def save(self, path: str | os.PathLike[str]) -> None:
+        """save_opencv."""
+        save_opencv(self, path)
+
+    @classmethod
+    def load(cls, path: str | os.PathLike[str]) -> Calibration:
+        """load_calibration: an OpenCV calibration file, or LEFT.yaml,RIGHT.yaml (ROS
+        camera_info)."""
+        return load_calibration(str(path))
 
 
 def save_opencv(calib: Calibration, path: str | os.PathLike[str]) -> None:

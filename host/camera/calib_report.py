@@ -7,7 +7,8 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from host.camera.calibration import Calibration, Rectifier
+from host.camera.calib_files import Calibration
+from host.camera.calibration import Rectifier
 from host.camera.source import StereoFrame
 
 GRID = (8, 6)  # coverage cells across, down

@@ -1,89 +1,29 @@
-"""Stereo calibration from chessboard pairs (with badly fitting views rejected), the rectified
-geometry, and rectification maps.
+"""Stereo calibration from chessboard pairs (with badly fitting views rejected), and
+rectification maps.
 
 Matrices keep the names of OpenCV's stereo_calib sample: M1 D1 M2 D2 (intrinsics), R T E F
 (right camera from left: X_r = R X_l + T, T in the units of --square, mm), R1 R2 P1 P2 Q
-(rectification). Files: host/camera/calib_files.py.
+(rectification). The Calibration itself and its files: host/camera/calib_files.py.
 """
 
 from __future__ import annotations
 
 import math
-import os
-import sys
 from dataclasses import dataclass, field
 
 import cv2
 import numpy as np
 
+# MATRICES, Calibration and Geometry re-exported for the modules that still import them here
+from host.camera.calib_files import MATRICES as MATRICES
+from host.camera.calib_files import Calibration as Calibration
+from host.camera.geometry import Geometry as Geometry
 from host.camera.source import CameraError, StereoFrame
 
 MIN_VIEWS = 15
 # a view is rejected when its RMS reprojection error exceeds both of these
 OUTLIER_FACTOR = 3.0  # times the median view's error
 OUTLIER_FLOOR_PX = 0.3
-MINORU_FOCAL_PX_320 = 426.0  # Minoru sensor at 320x240, without a calibration
-MINORU_BASELINE_M = 0.060
-MATRICES = ("M1", "D1", "M2", "D2", "R", "T", "E", "F", "R1", "R2", "P1", "P2", "Q")
-
-
-@dataclass(frozen=True)
-class Geometry:
-    """Rectified stereo geometry: Z = focal_px * baseline_m / disparity_px."""
-
-    focal_px: float
-    baseline_m: float
-    cx: float
-    cy: float
-
-    def depth_m(self, disparity_px: float) -> float:
-        return self.focal_px * self.baseline_m / disparity_px
-
-    def disparity_px(self, depth_m: float) -> float:
-        return self.focal_px * self.baseline_m / depth_m
-
-    def px_per_m(self, disparity_px: float) -> float:
-        """Depth resolution there: disparity change per metre of depth, d^2 / (f B) (one px of
-        disparity is Z^2 / (f B) of depth)."""
-        return disparity_px ** 2 / (self.focal_px * self.baseline_m)
-
-    @classmethod
-    def minoru_default(cls, width: int, height: int) -> Geometry:
-        scale = width / 320.0
-        print(f"no --calib: assuming the Minoru's nominal geometry, focal length "
-              f"{MINORU_FOCAL_PX_320 * scale:.0f} px at {width}x{height} and baseline "
-              f"{MINORU_BASELINE_M * 1000:.0f} mm", file=sys.stderr)
-        return cls(MINORU_FOCAL_PX_320 * scale, MINORU_BASELINE_M, width / 2, height / 2)
-
-
-@dataclass
-class Calibration:
-    size: tuple[int, int]  # (width, height) px
-    mats: dict[str, np.ndarray]  # MATRICES
-    rms: float  # px, reprojection RMS of the stereo fit (NaN when not known, e.g. from ROS)
-    epipolar_rms: float  # px, row difference of rectified corners
-
-    @property
-    def baseline_mm(self) -> float:
-        return float(np.linalg.norm(self.mats["T"]))
-
-    @property
-    def geometry(self) -> Geometry:
-        p1, p2 = self.mats["P1"], self.mats["P2"]
-        return Geometry(float(p1[0, 0]), abs(float(p2[0, 3] / p2[0, 0])) / 1000.0,
-                        float(p1[0, 2]), float(p1[1, 2]))
-
-    def save(self, path: str | os.PathLike[str]) -> None:
-        from host.camera.calib_files import save_opencv
-
-        save_opencv(self, path)
-
-    @classmethod
-    def load(cls, path: str | os.PathLike[str]) -> Calibration:
-        """An OpenCV calibration file, or LEFT.yaml,RIGHT.yaml (ROS camera_info)."""
-        from host.camera.calib_files import load_calibration
-
-        return load_calibration(str(path))
 
 
 @dataclass(frozen=True)

@@ -8,8 +8,9 @@ import sys
 from pathlib import Path
 
 from host.camera.bag import BagSource, is_bag
-from host.camera.calib_files import is_ideal
-from host.camera.calibration import Calibration, Geometry, Rectifier
+from host.camera.calib_files import Calibration, is_ideal
+from host.camera.calibration import Rectifier
+from host.camera.geometry import MINORU_BASELINE_M, Geometry
 from host.camera.live import LiveSource
 from host.camera.lr_check import CHECKS, handedness
 from host.camera.minoru import MinoruSource
@@ -152,4 +153,14 @@ def known_geometry(args: argparse.Namespace, source: StereoSource | None = None
 
 def source_geometry(args: argparse.Namespace, source: StereoSource | None = None) -> Geometry:
     """known_geometry, else the Minoru's nominal one at --size (said on stderr)."""
-    return known_geometry(args, source) or Geometry.minoru_default(*parse_size(args.size))
+    known = known_geometry(args, source)
+    return known if known is not None else default_geometry(*parse_size(args.size))
+
+
+def default_geometry(width: int, height: int) -> Geometry:
+    """Geometry.minoru_default, said on stderr (no calibration was given)."""
+    g = Geometry.minoru_default(width, height)
+    print(f"no --calib: assuming the Minoru's nominal geometry, focal length "
+          f"{g.focal_px:.0f} px at {width}x{height} and baseline "
+          f"{MINORU_BASELINE_M * 1000:.0f} mm", file=sys.stderr)
+    return g

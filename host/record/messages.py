@@ -9,8 +9,9 @@ from typing import Any
 import numpy as np
 from rosbags.typesys import Stores, get_typestore
 
+from host.camera.calib_files import Calibration
 from host.camera.calib_files import camera_info as camera_info_fields
-from host.camera.calibration import Calibration, Geometry
+from host.camera.geometry import Geometry
 
 STORE = get_typestore(Stores.ROS2_HUMBLE)
 T = STORE.types

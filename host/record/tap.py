@@ -11,8 +11,8 @@ from typing import Any
 
 import numpy as np
 
-from host.camera.calib_files import ideal_calibration
-from host.camera.calibration import Calibration, Geometry
+from host.camera.calib_files import Calibration, ideal_calibration
+from host.camera.geometry import Geometry
 from host.camera.source import StereoFrame, StereoSource
 from host.link import protocol_gen as gen
 from host.record import messages as m

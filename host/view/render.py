@@ -9,7 +9,7 @@ from typing import Any
 import cv2
 import numpy as np
 
-from host.camera.calibration import Geometry
+from host.camera.geometry import Geometry
 from host.servo.snapshot import Snapshot
 
 INVALID_BGR = (128, 128, 128)  # pixels without a disparity: plain grey (not in the colour map)

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 import yaml
 
-from host.camera.calib_files import load_calibration, ros_text, save_ros
-from host.camera.calibration import MATRICES, Calibration, Rectifier
+from host.camera.calib_files import MATRICES, Calibration, load_calibration, ros_text, save_ros
+from host.camera.calibration import Rectifier
 from host.camera.source import CameraError
 from host.cli import main
 

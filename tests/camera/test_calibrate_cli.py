@@ -7,7 +7,7 @@ from pathlib import Path
 
 import cv2
 
-from host.camera.calibration import Calibration
+from host.camera.calib_files import Calibration
 from host.cli import main
 
 from .boards import BASELINE_MM, BOARD, SQUARE_MM, bent_view, views
