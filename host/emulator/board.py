@@ -5,17 +5,22 @@ from __future__ import annotations
 
 import threading
 import time
+from functools import cache
 from typing import Protocol
 
+from host.emulator.build import config_define
 from host.emulator.pins import Io
 
-PWM_TOP = 400  # ICR1, firmware/atmega328/config.h
+
+@cache
+def pwm_top() -> int:
+    """Timer1's TOP (ICR1), read from the firmware's config.h: OCR1x = duty * PWM_TOP / 1000."""
+    return config_define("PWM_TOP")
 
 
 class Board(Protocol):
-    """A robot the simulated world can drive: its serial port, its motor outputs, its clock."""
-
-    path: str
+    """A robot the simulated world can drive (native core, simavr ELF, simulated Uno, a test's
+    fake): its motor outputs and its clock."""
 
     def motors(self) -> tuple[int, int]:
         """Duty (permille) applied to the left and right motor."""
@@ -26,9 +31,15 @@ class Board(Protocol):
         ...
 
 
+class PtyBoard(Board, Protocol):
+    """A board running the AVR binary in real time, its UART on a pseudo-terminal."""
+
+    path: str  # the pty the host opens
+
+
 def duty(ocr: int, forward: bool, reverse: bool) -> int:
     """Duty in permille from a Timer1 compare value and the bridge's two direction inputs."""
-    magnitude = ocr * 1000 // PWM_TOP
+    magnitude = ocr * 1000 // pwm_top()
     return magnitude if forward and not reverse else -magnitude if reverse and not forward else 0
 
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -43,6 +44,26 @@ def need_sources(*paths: Path) -> None:
     if missing:
         raise HostError(f"the firmware sources are missing ({missing[0]}): reinstall "
                         "stereo-servo from its wheel or sdist, or run from a source checkout")
+
+
+def firmware_sources() -> list[Path]:
+    """The C files the firmware Makefile's SOURCES names (the one list of them), as paths."""
+    makefile = FIRMWARE / "Makefile"
+    need_sources(makefile)
+    text = makefile.read_text().replace("\\\n", " ")
+    variables = dict(re.findall(r"^(\w+)\s*:=\s*(.*)$", text, re.MULTILINE))
+    words = re.sub(r"\$\((\w+)\)", lambda m: variables[m.group(1)], variables["SOURCES"])
+    return [(FIRMWARE / w).resolve() for w in words.split()]
+
+
+def config_define(name: str) -> int:
+    """A whole-number #define of firmware/atmega328/config.h (e.g. PWM_TOP)."""
+    config = FIRMWARE / "config.h"
+    need_sources(config)
+    m = re.search(rf"^#define {name} (\d+)\b", config.read_text(), re.MULTILINE)
+    if m is None:
+        raise BuildFailed(f"{config}: no #define {name} NUMBER")
+    return int(m.group(1))
 
 
 def need_simavr() -> None:

@@ -17,11 +17,18 @@ from host.emulator.build import (
     BuildFailed,
     ToolMissing,
     digest,
+    firmware_sources,
     need_sources,
 )
 
-SOURCES = [FIRMWARE / "core" / "robot.c", FIRMWARE / "core" / "drive.c",
-           FIRMWARE / "core" / "link.c", FIRMWARE / "emu" / "board.c", PROTOCOL_C / "frame.c"]
+
+def sources() -> list[Path]:
+    """The firmware's register-free sources (its Makefile's SOURCES but the AVR layer's), with
+    the emulated board (firmware/atmega328/emu/board.c) in place of avr/."""
+    avr = (FIRMWARE / "avr").resolve()
+    portable = [p for p in firmware_sources() if avr not in p.parents]
+    core = [p for p in portable if p.parent == (FIRMWARE / "core").resolve()]
+    return [*core, FIRMWARE / "emu" / "board.c", *(p for p in portable if p not in core)]
 
 
 def _headers() -> list[Path]:
@@ -32,17 +39,18 @@ def _headers() -> list[Path]:
 def build_library() -> Path:
     """Compile the core into a shared library in the user cache, keyed by a hash of its
     sources (the checkout's, or those the package ships)."""
-    need_sources(*SOURCES, FIRMWARE / "config.h")
+    srcs = sources()
+    need_sources(*srcs, FIRMWARE / "config.h")
     if shutil.which("gcc") is None:
         raise ToolMissing("gcc not found: the emulator compiles the firmware core natively "
                           "(install gcc)")
-    lib = CACHE / f"firmware-core-{digest(SOURCES + _headers())}.so"
+    lib = CACHE / f"firmware-core-{digest(srcs + _headers())}.so"
     if lib.exists():
         return lib
     CACHE.mkdir(parents=True, exist_ok=True)
     tmp = lib.with_suffix(f".{os.getpid()}.tmp")
     cmd = ["gcc", "-std=gnu11", "-O2", "-shared", "-fPIC", "-Wall", "-Wextra", "-Werror",
-           f"-I{PROTOCOL_C}", *map(str, SOURCES), "-o", str(tmp)]
+           f"-I{PROTOCOL_C}", *map(str, srcs), "-o", str(tmp)]
     r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode:
         raise BuildFailed(f"building the firmware core failed: {r.stderr.strip()[:300]}")

@@ -12,6 +12,7 @@ from pathlib import Path
 
 from host.emulator.board import MotorPins, WallClock
 from host.emulator.pins import Io
+from host.emulator.process import stop
 from host.link import protocol_gen as gen
 from host.link.frame import Frame, FrameDecoder, encode_frame
 from host.link.messages import pack
@@ -183,9 +184,10 @@ class SimavrPty:
         self._clock.advance(ms)
 
     def close(self) -> None:
-        if self._proc.poll() is None:
-            self._proc.terminate()
-            self._proc.wait(timeout=5)
+        """Stop the simulator (killed if it does not exit within 5 s)."""
+        stop(self._proc)
+        if hasattr(self, "_reader"):
+            self._reader.join(timeout=2)
 
     def __enter__(self) -> SimavrPty:
         return self

@@ -11,6 +11,7 @@ from pathlib import Path
 
 from host.emulator import build
 from host.emulator.board import MotorPins, WallClock
+from host.emulator.process import stop
 from host.errors import HostError
 
 # Debian's arduino-core-avr: optiboot 4.4, the version Unos carry (Debian's build overruns the
@@ -109,13 +110,7 @@ class SimulatedUno:
 
     def close(self) -> None:
         """Stop the board; it saves the flash file first if the bootloader changed it."""
-        if self._proc.poll() is None:
-            self._proc.terminate()
-            try:
-                self._proc.wait(timeout=5)
-            except subprocess.TimeoutExpired:
-                self._proc.kill()
-                self._proc.wait()
+        stop(self._proc)
         self._reader.join(timeout=2)
 
     def __enter__(self) -> SimulatedUno:

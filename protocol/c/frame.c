@@ -53,7 +53,7 @@ static uint8_t step(struct frame_parser *p, uint8_t byte, frame_handler handler,
         return 0;
     default: /* FRAME_READ_BODY */
         p->buf[p->count++] = byte;
-        if (p->count < 3u + p->buf[0] + PROTO_CRC_LEN)
+        if (p->count < (PROTO_HEADER_LEN - 1u) + p->buf[0] + PROTO_CRC_LEN) /* after START */
             return 0;
         p->state = FRAME_WAIT_START;
         uint8_t n = p->count - PROTO_CRC_LEN;
