@@ -10,11 +10,13 @@ import struct
 from dataclasses import fields
 from typing import Any
 
+from host.errors import HostError
 from host.link import protocol_gen as gen
 
 
-class ProtocolError(Exception):
-    """A payload that is not a valid message; code is the protocol's error code."""
+class ProtocolError(HostError):
+    """A payload that is not a valid message; code is the protocol's error code (a HostError:
+    one line and exit status 2 when it reaches the CLI)."""
 
     def __init__(self, code: gen.Error, message: str) -> None:
         super().__init__(message)
