@@ -29,10 +29,6 @@ class StereoFrame:
     t_right: float
 
     @property
-    def t(self) -> float:
-        return max(self.t_left, self.t_right)
-
-    @property
     def skew_ms(self) -> float:
         return abs(self.t_left - self.t_right) * 1000
 

@@ -1,4 +1,5 @@
-"""Own block matcher: SAD / SSD / zero-mean NCC with running sums, WTA and sub-pixel fit.
+"""Own block matcher: SSD / zero-mean NCC with running sums, WTA and sub-pixel fit (SAD is
+sad.py's kernel, which shares this module's padding and decision helpers).
 
 Conventions: the left image is the reference; a left pixel x matches right pixel x - d; the output
 is float32 disparity in pixels with NaN where the matcher gives no disparity. Window sums are kept
@@ -14,24 +15,16 @@ from numba import njit, prange
 
 from host.stereo.subpixel import FIT_NONE, fit_offset
 
-COST_SAD = 0
 COST_SSD = 1
 COST_NCC = 2
-COSTS = {"sad": COST_SAD, "ssd": COST_SSD, "ncc": COST_NCC}
+COSTS = {"ssd": COST_SSD, "ncc": COST_NCC}
 
 
 @njit(cache=True, fastmath=True, inline="always")
 def _slide(c, a, rn, o, ro, kind, first):
     # One column's sums move a row down: add the entering pixel's costs, drop the leaving one's.
     # c, rn and ro are 1-D views so the loop over k is contiguous and vectorises.
-    if kind == COST_SAD:
-        if first:
-            for k in range(c.size):
-                c[k] += abs(a - np.int32(rn[k]))
-        else:
-            for k in range(c.size):
-                c[k] = np.int32(c[k] + abs(a - np.int32(rn[k])) - abs(o - np.int32(ro[k])))
-    elif kind == COST_SSD:
+    if kind == COST_SSD:
         if first:
             for k in range(c.size):
                 e = a - np.int32(rn[k])
@@ -142,7 +135,7 @@ def _pack_shift(kind, nd, size, channels):
     bits = 0
     while (1 << bits) < nd:
         bits += 1
-    top = channels * size * size * (255 if kind == COST_SAD else 255 * 255)
+    top = channels * size * size * 255 * 255  # SSD
     return bits if top < (1 << (31 - bits)) else -1
 
 
