@@ -10,7 +10,7 @@ DATA ?= $(abspath ../shared/data)
 # tests and benchmarks find the Middlebury scenes through this variable
 export STEREO_SERVO_DATA ?= $(if $(wildcard $(DATA)/middlebury/index.json),$(DATA),)
 
-.PHONY: demo test lint bench venv system-deps browser-deps platformio protocol firmware flash mutants fuzz clean
+.PHONY: demo test lint typecheck bench venv system-deps browser-deps platformio protocol firmware flash mutants fuzz clean
 
 $(BIN)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -41,11 +41,15 @@ demo: venv
 	$(BIN)/host servo --sim --border clip --num-disp 48 --log $(OUT)/servo.csv --plot $(OUT)/servo.png
 	@echo "pictures: $(OUT)/motorcycle.png (disparity), $(OUT)/tuning.png (tuning), $(OUT)/servo.png (servo run)"
 
-test: venv system-deps browser-deps platformio lint
+test: venv system-deps browser-deps platformio lint typecheck
 	$(BIN)/python -m pytest
 
 lint: venv
 	$(BIN)/ruff check host tools bench tests
+
+# mypy, strict on host/ as pyproject.toml's [tool.mypy] configures it (relaxations said there)
+typecheck: venv
+	$(BIN)/mypy
 
 bench: venv
 	$(BIN)/python bench/matcher.py

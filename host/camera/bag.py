@@ -13,9 +13,12 @@ import time
 from collections import deque
 from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from host.camera.source import CameraError, StereoFrame, StereoSource
+
+if TYPE_CHECKING:
+    from host.camera.calib_files import Calibration
 
 IMAGE = "sensor_msgs/msg/Image"
 CAMERA_INFO = "sensor_msgs/msg/CameraInfo"
@@ -54,8 +57,8 @@ class BagSource(StereoSource):
         self.frames = 0
         self.topics: dict[str, str] = {}  # side -> image topic
         self._pending: deque[tuple[str, Any]] = deque()  # read ahead at open
-        self._images: dict[str, deque] = {"left": deque(), "right": deque()}
-        self._infos: dict[str, Any] = {}
+        self._images: dict[str, deque[Any]] = {"left": deque(), "right": deque()}
+        self._infos: dict[str | None, Any] = {}
         self._ns0: int | None = None  # the first pair's left stamp (ns)
         self._t0: tuple[float, float] | None = None  # (first frame's stamp, wall time then)
         self._last: tuple[float, float] | None = None  # (last frame's stamp, wall time then)
@@ -92,7 +95,7 @@ class BagSource(StereoSource):
                 raise CameraError(f"{self.path}: a {schema.name} on {channel.topic} does not "
                                   f"decode ({type(e).__name__})") from None
 
-    def _prefetch(self):
+    def _prefetch(self) -> Calibration | None:
         """Read until both CameraInfos are known (or PREFETCH messages): the calibration."""
         for _ in range(PREFETCH):
             item = self._read_message()
@@ -167,7 +170,7 @@ class BagSource(StereoSource):
             return 0.0
         return self._last[0] + (time.monotonic() - self._last[1]) * (self.speed or 1.0)
 
-    def describe(self) -> dict:
+    def describe(self) -> dict[str, Any]:
         return {"camera": f"replay:{self.path}", "kind": "bag", "recorded_from": None}
 
     def ended(self) -> str:

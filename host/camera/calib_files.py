@@ -14,6 +14,7 @@ import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -176,7 +177,7 @@ def _ros_matrix(m: np.ndarray) -> str:
     return f"\n  rows: {rows}\n  cols: {cols}\n  data: [{data}]"
 
 
-def camera_info(calib: Calibration, side: str) -> dict:
+def camera_info(calib: Calibration, side: str) -> dict[str, Any]:
     """One camera's camera_info fields (side: left or right): width, height, distortion_model
     and K, D, R, P as arrays, P's Tx in metres as ROS has it. The one source of both the --ros
     files and the recordings' sensor_msgs/CameraInfo."""
@@ -230,8 +231,9 @@ def save_ros(calib: Calibration, folder: Path) -> tuple[Path, Path]:
     return paths
 
 
-def _ros_field(path: str, info: dict, key: str, shape: tuple[int, int] | None) -> np.ndarray:
-    node = info.get(key)
+def _ros_field(path: str, info: dict[str, Any], key: str, shape: tuple[int, int] | None
+               ) -> np.ndarray:
+    node: Any = info.get(key)
     try:
         data = np.array(node["data"], np.float64)
         rows, cols = int(node["rows"]), int(node["cols"])
@@ -287,7 +289,7 @@ def load_ros(left_path: str, right_path: str) -> Calibration:
     return from_camera_info(size, left, right, right_path)
 
 
-def from_camera_info(size: tuple[int, int], left: dict, right: dict,
+def from_camera_info(size: tuple[int, int], left: dict[str, Any], right: dict[str, Any],
                      right_name: str = "the right camera_info") -> Calibration:
     """A stereo calibration from the two cameras' K (or M), D, R, P (Tx in metres): the
     rectification is theirs; R, T, E, F and Q are rebuilt from it (R = R2^T R1, T = R2^T t,

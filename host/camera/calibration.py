@@ -69,16 +69,19 @@ def board_points(board: tuple[int, int], square_mm: float) -> np.ndarray:
     return np.hstack([grid * square_mm, np.zeros((len(grid), 1), np.float32)])
 
 
-def _stereo_fit(obj, left, right, size):
+def _stereo_fit(obj: list[np.ndarray], left: list[np.ndarray], right: list[np.ndarray],
+                size: tuple[int, int]) -> tuple[float, dict[str, np.ndarray], np.ndarray]:
     """Each camera alone, then the pair: (rms, mats M1 D1 M2 D2 R T E F, per-view RMS (n, 2))."""
     # k3 stays 0: webcam lenses are narrow, and a free k3 fits noise at the image corners
     flags = cv2.CALIB_FIX_K3
     _, m1, d1, _, _ = cv2.calibrateCamera(obj, left, size, None, None, flags=flags)
     _, m2, d2, _, _ = cv2.calibrateCamera(obj, right, size, None, None, flags=flags)
     term = (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_MAX_ITER, 100, 1e-6)
-    rms, m1, d1, m2, d2, r, t, e, f, _, _, per_view = cv2.stereoCalibrateExtended(
+    # cv2's stubs want R and T arrays; OpenCV takes None (allocate them) at run time
+    fit = cv2.stereoCalibrateExtended(  # type: ignore[call-overload]
         obj, left, right, m1, d1, m2, d2, size, None, None, criteria=term,
         flags=cv2.CALIB_USE_INTRINSIC_GUESS | flags)
+    rms, m1, d1, m2, d2, r, t, e, f, _, _, per_view = fit
     mats = {"M1": m1, "D1": d1, "M2": m2, "D2": d2, "R": r, "T": t, "E": e, "F": f}
     return float(rms), mats, np.asarray(per_view).reshape(-1, 2)
 
@@ -90,7 +93,8 @@ def _rectify(mats: dict[str, np.ndarray], size: tuple[int, int]) -> None:
     mats.update({"R1": r1, "R2": r2, "P1": p1, "P2": p2, "Q": q})
 
 
-def epipolar_rms(mats: dict[str, np.ndarray], left: list, right: list) -> float:
+def epipolar_rms(mats: dict[str, np.ndarray], left: list[np.ndarray], right: list[np.ndarray]
+                 ) -> float:
     """RMS row difference (px) of matching corners after rectification."""
     rows = []
     for cl, cr in zip(left, right):

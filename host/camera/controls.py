@@ -47,7 +47,7 @@ def fourcc_text(code: float) -> str:
 
 def request(cap: Any, asked: Format) -> None:
     """Ask the driver for a format (it may grant another: read it back with granted())."""
-    cap.set(cv2.CAP_PROP_FOURCC, cv2.VideoWriter_fourcc(*asked.fourcc))
+    cap.set(cv2.CAP_PROP_FOURCC, cv2.VideoWriter_fourcc(*asked.fourcc))  # type: ignore[attr-defined]  # cv2 stubs lack it
     cap.set(cv2.CAP_PROP_FRAME_WIDTH, asked.width)
     cap.set(cv2.CAP_PROP_FRAME_HEIGHT, asked.height)
     cap.set(cv2.CAP_PROP_FPS, asked.fps)

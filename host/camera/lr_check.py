@@ -42,9 +42,9 @@ def handedness(left: np.ndarray, right: np.ndarray, max_disp: int | None = None,
     gl, gr = _grey(left), _grey(right)
     h, w = gl.shape
     nd = max_disp or max(16, (w // 4) // 16 * 16)
-    sgbm = cv2.StereoSGBM_create(minDisparity=-nd, numDisparities=2 * nd, blockSize=7,
-                                 P1=8 * 49, P2=32 * 49, uniquenessRatio=10,
-                                 mode=cv2.STEREO_SGBM_MODE_SGBM)
+    sgbm = cv2.StereoSGBM_create(  # type: ignore[attr-defined]  # absent from cv2's stubs
+        minDisparity=-nd, numDisparities=2 * nd, blockSize=7, P1=8 * 49, P2=32 * 49,
+        uniquenessRatio=10, mode=cv2.STEREO_SGBM_MODE_SGBM)
     disp = sgbm.compute(gl, gr).astype(np.float32) / 16.0
     f = gl.astype(np.float32)
     std = np.sqrt(np.maximum(cv2.blur(f * f, (7, 7)) - cv2.blur(f, (7, 7)) ** 2, 0))

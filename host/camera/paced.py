@@ -44,7 +44,7 @@ class PacedSource(StereoSource):
                 self._t0 = (frame.t_left, now)
         return frame
 
-    def describe(self) -> dict:
+    def describe(self) -> dict[str, Any]:
         return self.inner.describe()
 
     def close(self) -> None:

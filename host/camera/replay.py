@@ -4,6 +4,7 @@ them) or two video files."""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import cv2
 
@@ -68,7 +69,7 @@ class ReplaySource(StereoSource):
         self._index += 1
         return StereoFrame(read_image(left), read_image(right), t_left, t_right)
 
-    def describe(self) -> dict:
+    def describe(self) -> dict[str, Any]:
         recorded = self.manifest["camera"] if self.manifest else None
         return {"camera": f"replay:{self.path}", "kind": "replay", "recorded_from": recorded}
 

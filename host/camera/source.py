@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -59,7 +59,7 @@ class StereoSource:
         self._skews_ms.append(frame.skew_ms)
         return self.rectify(frame) if self.rectify else frame
 
-    def describe(self) -> dict:
+    def describe(self) -> dict[str, Any]:
         """What this source is, for a capture's manifest."""
         return {"kind": type(self).__name__}
 

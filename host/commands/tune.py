@@ -39,7 +39,7 @@ DEFAULT_ITERATIONS = {"paper": 20, "guided": 20, "qlearning": 300, "random": 60,
                       "tpe": 60}
 
 
-def add_parser(sub: argparse._SubParsersAction) -> None:
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p = sub.add_parser("tune", help="tune the matcher's parameters (against ground truth, or "
                                     "self-supervised on a camera's frames)")
     p.add_argument("scenes", nargs="*", type=Path, metavar="SCENE_DIR",
@@ -101,7 +101,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 TUNE_BORDER = "clip"  # bench/tuning.py and docs/tuning.md measured every figure with it
 
 
-def _progress(total: int, enabled: bool, what: str):
+def _progress(total: int, enabled: bool, what: str) -> Any:
     """A progress bar on stderr (a terminal only), one tick per learner step."""
     if not enabled:
         return None
@@ -249,7 +249,7 @@ def run(args: argparse.Namespace) -> int:
         table.close()
     best = space.params(result.best_state)
     tuned_on = scenes[:n_tune]
-    held = {s.name: row[i] for i, s in enumerate(scenes) if i >= n_tune}
+    held_out = {s.name: row[i] for i, s in enumerate(scenes) if i >= n_tune}
     truth = None
     if args.objective == "self" and all(s.gt is not None for s in scenes):
         # the self-tuned parameters scored against the ground truth it did not use
@@ -270,7 +270,7 @@ def run(args: argparse.Namespace) -> int:
             plot(result, args.plot, score="bad pixels (%)" if args.objective == "gt"
                  else "self-supervised score (%)", scenes=tuple(s.name for s in tuned_on))
     out = result.to_json() | {"objective": args.objective,
-                              "scenes": [s.name for s in tuned_on], "held_out": held,
+                              "scenes": [s.name for s in tuned_on], "held_out": held_out,
                               "disparity_range": str(policy),
                               "ranges": {s.name: list(r) for s, r in zip(scenes, ranges)}}
     if args.cv:
@@ -286,7 +286,7 @@ def run(args: argparse.Namespace) -> int:
           f"{len(result.history)} iterations, {result.evaluations} distinct evaluations")
     for name, bad in (truth or {}).items():
         print(f"  {name}: {bad:.2f}% bad against its ground truth (not used for tuning)")
-    for name, bad in held.items():
+    for name, bad in held_out.items():
         print(f"  held out {name}: {bad:.2f}% {what} with the tuned parameters")
     for name, f in folds.items():
         print(f"  left out {name}: {f['bad']:.2f}% {what} with {f['params']} "

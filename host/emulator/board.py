@@ -58,11 +58,12 @@ class MotorPins:
             io = Io(int(rest[0]), *(int(x, 16) for x in rest[1:]))
             event = (io.cycle, io.ocr1a, io.ocr1b, io.portd >> 4 & 0xF)
         elif kind == "pwm":  # the simulated Uno
-            event = tuple(map(int, rest))
+            a, b, c, d = map(int, rest)
+            event = (a, b, c, d)
         else:
             return False
         with self._lock:
-            self.events.append(event)  # type: ignore[arg-type]
+            self.events.append(event)
         return True
 
     def motors(self) -> tuple[int, int]:

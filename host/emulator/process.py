@@ -5,7 +5,7 @@ from __future__ import annotations
 import subprocess
 
 
-def stop(proc: subprocess.Popen, timeout_s: float = 5.0) -> None:
+def stop(proc: subprocess.Popen[str], timeout_s: float = 5.0) -> None:
     """Terminate proc and wait for it; kill it if it has not exited within timeout_s."""
     if proc.poll() is not None:
         return

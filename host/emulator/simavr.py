@@ -99,7 +99,7 @@ class Script:
         self.lines.append(f"send {data.hex()}")
         return self
 
-    def message(self, seq: int, msg) -> Script:
+    def message(self, seq: int, msg: object) -> Script:
         return self.send(encode_frame(seq, *pack(msg)))
 
     def run_ms(self, ms: float) -> Script:

@@ -121,7 +121,7 @@ class SimulatedUno:
 
 
 def avrdude(port: str, hex_file: Path, timeout_s: float = 90,
-            extra: tuple[str, ...] = ()) -> subprocess.CompletedProcess:
+            extra: tuple[str, ...] = ()) -> subprocess.CompletedProcess[str]:
     """Upload hex_file through an Uno's bootloader, as `make flash` does; output in .stderr."""
     build._need("avrdude", "avrdude")
     return subprocess.run(["avrdude", "-p", "atmega328p", "-c", "arduino", "-P", port,

@@ -18,7 +18,7 @@ _crc = crcmod.predefined.mkCrcFun(gen.CRC_NAME)
 
 def crc(data: bytes) -> int:
     """The protocol's CRC (gen.CRC_NAME, CRC-32C) of LEN SEQ ID PAYLOAD."""
-    return _crc(data)
+    return int(_crc(data))
 
 
 @dataclass(frozen=True)

@@ -38,7 +38,7 @@ def pack(msg: Any) -> tuple[int, bytes]:
 
 def unpack(msg_id: int, payload: bytes) -> Any:
     """The message object for a frame's id and payload, checked as the receiver checks it."""
-    cls = gen.MESSAGES.get(msg_id)
+    cls: Any = gen.MESSAGES.get(msg_id)  # a generated message class: ID, SIZE, FORMAT ...
     if cls is None:
         raise ProtocolError(gen.Error.UNKNOWN_ID, f"unknown message id 0x{msg_id:02X}")
     if len(payload) != cls.SIZE:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import os
 from collections import Counter
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -23,7 +24,7 @@ class BagInfo:
     recorder: str = ""  # the last "recorder" diagnostic's message, if any
 
 
-def _messages(path: Path, info: BagInfo):
+def _messages(path: Path, info: BagInfo) -> Iterator[tuple[Any, Any, Any]]:
     """(schema, channel, message) of every complete message; info.closed tells how it ended."""
     from mcap.exceptions import InvalidMagic, McapError
     from mcap.reader import NonSeekingReader
@@ -55,7 +56,7 @@ def scan(path: Path, on_message: Any = None) -> BagInfo:
                 from rosbags.typesys import Stores, get_typestore
 
                 store = get_typestore(Stores.ROS2_HUMBLE)
-            msg = store.deserialize_cdr(message.data, schema.name)
+            msg: Any = store.deserialize_cdr(message.data, schema.name)
             for status in msg.status:
                 if status.name == "recorder":
                     info.recorder = status.message
@@ -77,7 +78,7 @@ def repair(src: Path, dst: Path) -> BagInfo:
             writer = Writer(f, chunk_size=4 << 20, compression=CompressionType.ZSTD)
             writer.start(profile="ros2", library="stereo-servo host bag --repair")
 
-            def copy(schema, channel, message) -> None:
+            def copy(schema: Any, channel: Any, message: Any) -> None:
                 if schema is not None and schema.id not in schemas:
                     schemas[schema.id] = writer.register_schema(schema.name, schema.encoding,
                                                                 schema.data)

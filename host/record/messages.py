@@ -93,7 +93,7 @@ def camera_info(calib: Calibration, side: str, ns: int) -> Any:
                           p=f["P"].ravel().copy(), binning_x=0, binning_y=0, roi=roi)
 
 
-def info_fields(msg: Any) -> dict:
+def info_fields(msg: Any) -> dict[str, Any]:
     """The K, D, R, P (and size) a sensor_msgs/CameraInfo holds, as calib_files names them."""
     return {"width": int(msg.width), "height": int(msg.height),
             "K": np.asarray(msg.k, np.float64).reshape(3, 3),

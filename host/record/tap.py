@@ -56,7 +56,7 @@ class RecordingSource(StereoSource):
         rec.put("frame", build)
         return frame
 
-    def describe(self) -> dict:
+    def describe(self) -> dict[str, Any]:
         return self.inner.describe()
 
     def close(self) -> None:
@@ -111,7 +111,7 @@ class StepRecorder:
 
 def robot_status(s: Any) -> Any:
     """The robot's STATUS as a DiagnosticStatus: duty, link lost, reset cause, counters."""
-    flags = [f.name.lower() for f in gen.StatusFlag if s.flags & f]
+    flags = [str(f.name).lower() for f in gen.StatusFlag if s.flags & f]
     try:
         cause = gen.ResetCause(s.reset_cause).name.lower()
     except ValueError:

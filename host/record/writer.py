@@ -65,7 +65,8 @@ class BagFile:
                  chunk_bytes: int = CHUNK_BYTES) -> None:
         self.path = path
         self._file = _Direct(path)
-        self._mcap = Writer(self._file, chunk_size=chunk_bytes,
+        self._mcap = Writer(self._file,  # type: ignore[arg-type]  # a binary file, not an IO
+                            chunk_size=chunk_bytes,
                             compression=COMPRESSIONS[compression])
         self._mcap.start(profile="ros2", library="stereo-servo host record")
         self.counts: Counter[str] = Counter()

@@ -3,6 +3,8 @@ Minoru, a replay folder or video, or the simulated world seen from several robot
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from host.camera.source import StereoSource
@@ -25,7 +27,7 @@ def spread_pairs(source: StereoSource, count: int, live: bool
                 break
     else:
         every = [(f.left, f.right) for f in source]
-        picks = np.unique(np.linspace(0, len(every) - 1, count).round().astype(int)) \
+        picks: Any = np.unique(np.linspace(0, len(every) - 1, count).round().astype(int)) \
             if every else []
         frames = [every[i] for i in picks]
     if not frames:

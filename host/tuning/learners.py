@@ -143,7 +143,7 @@ def paper(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
     q = np.zeros((n, 3))  # actions: shrink, keep, grow
     s = int(rng.integers(n))
     bad_s = obj((s,))
-    history = []
+    history: list[tuple[State, float]] = []
     for _ in range(iterations):
         if rng.random() < epsilon:
             a = int(rng.integers(3))
@@ -167,7 +167,7 @@ def guided(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
     q = np.zeros((n, 3))  # actions: shrink, keep, grow
     s = int(rng.integers(n))
     bad_s = obj((s,))
-    history = []
+    history: list[tuple[State, float]] = []
     prefer = None
     for _ in range(iterations):
         a = _greedy(q[s], epsilon, rng, keep=1, prefer=prefer)
@@ -257,7 +257,7 @@ def tpe(obj: Run, space: Space, iterations: int, seed: int,
     study = optuna.create_study(sampler=sampler)
     history: list[tuple[State, float]] = []
 
-    def objective(trial) -> float:
+    def objective(trial: Any) -> float:
         state = tuple(trial.suggest_categorical(d.name, list(range(len(d.values)))) if d.cyclic
                       else trial.suggest_int(d.name, 0, len(d.values) - 1) for d in space.dims)
         bad = obj(state)

@@ -15,7 +15,7 @@ import json
 import secrets
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Awaitable, Callable
 from importlib import resources
 
 from aiohttp import WSMsgType, web
@@ -129,11 +129,13 @@ class ViewServer:
     # ------------------------------------------------------------------------ handlers
 
     @web.middleware
-    async def _guard(self, request: web.Request, handler):
+    async def _guard(self, request: web.Request,
+                     handler: Callable[[web.Request], Awaitable[web.StreamResponse]]
+                     ) -> web.StreamResponse:
         """The token (when one is needed) on every request; STOP only from the page's own
         origin, so another site open in the same browser cannot press it."""
         if self.token is not None:
-            given = request.query.get("token") or request.headers.get("X-View-Token", "")
+            given = request.query.get("token") or request.headers.get("X-View-Token") or ""
             if not hmac.compare_digest(given.encode(), self.token.encode()):
                 raise web.HTTPForbidden(text="a token is needed: use the address printed at "
                                              "start\n")
