@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import subprocess
 
+import pytest
+
 from host.emulator.pins import timeline
 from host.emulator.simavr import F_CPU, SimRun, parse
 from host.link import protocol_gen as gen
@@ -77,7 +79,8 @@ def test_a_link_loss_cut_is_never_undone_or_lost_wherever_the_tick_lands(
         harness, firmware_elf) -> None:
     """board-lock-without-cli, motor-output-outside-the-lock: while the ramp writes the motors
     every ms, the deadline's tick lands at each instruction of the passes around it. The cut
-    must hold (the bridge never driven again before a new SET_DRIVE) and be reported (STATUS:
+    must hold (the bridge never driven again before a new SET_DRIVE, nor OCR1x written non-zero)
+    and be reported (STATUS:
     LINK_LOST, one link loss, duty 0): a trip that falls between the main loop's read and its
     write would be undone, or cleared unseen."""
     before = ["run 2", frame(0, gen.SetConfig(link_timeout_ms=50, accel_limit=100)), "run 2",
@@ -92,6 +95,13 @@ def test_a_link_loss_cut_is_never_undone_or_lost_wherever_the_tick_lands(
               (status.left, status.right) == (0, 0))
         for motor in ("left", "right"):
             ok = ok and len(driven_spans(r, motor, 0)) == 1
+        # and at the registers behind the pins: once both compare values were written 0 (the
+        # cut), neither is written non-zero again; an undo within one PWM period would not show
+        # at the pin, yet the new value would take effect at TOP and drive on until the next pass
+        duty = [(p.ocr1a, p.ocr1b) for p in r.pwm]
+        on = next(i for i, d in enumerate(duty) if d != (0, 0))
+        cut = next((i for i in range(on, len(duty)) if duty[i] == (0, 0)), len(duty))
+        ok = ok and cut < len(duty) and all(d == (0, 0) for d in duty[cut:])
         if not ok:
             bad.append((k, status))
     assert not bad, f"{len(bad)} of {len(trials)} trials: first {bad[0]}"
@@ -123,3 +133,28 @@ def test_the_clock_read_at_a_carry_is_never_torn_wherever_the_tick_lands(
             bad.append((k, acked, status))
     assert not bad, f"{len(bad)} of {len(trials)} trials: first {bad[0]}"
 
+
+@pytest.mark.parametrize("seq", [2, 1], ids=["new-seq", "resend"])
+def test_a_drive_acknowledged_at_the_deadline_is_still_driven(harness, firmware_elf, seq) -> None:
+    """A keepalive SET_DRIVE handled just as the deadline of the one before passes, the tick that
+    trips the guard landing at each of its instructions: whatever the ACK says it was (APPLIED,
+    or DUPLICATE for a resend of the drive in force), the drive must be in force after it, not
+    cut by a trip that fell between the catch-up and the refresh of the deadline."""
+    before = ["run 2", frame(0, gen.SetConfig(link_timeout_ms=50, accel_limit=0)), "run 2",
+              frame(1, DRIVE), "run 50.45", frame(seq, DRIVE), "run 0.95"]
+    after = ["run 25", frame(3, gen.GetStatus()), "run 6"]
+    trials = sweep(harness, firmware_elf, before, 2500, after)
+    bad = []
+    for k, r in enumerate(trials):
+        acks = [(c, m) for c, m in zip(frame_cycles(r), messages(r))
+                if m.NAME == "ACK" and m.seq == seq]
+        ack_at, ack = acks[-1]
+        status = status_of(r)
+        # driven from the ACK on (or from the end of a coast that a link-loss stop caught up
+        # before the drive began), and never cut again
+        spans = [driven_spans(r, motor, ack_at + PWM_PERIOD) for motor in ("left", "right")]
+        ok = (status is not None and status.flags & gen.StatusFlag.DRIVING and
+              all(len(s) == 1 and s[0][1] == r.end_cycle for s in spans))
+        if not ok:
+            bad.append((k, ack.result, status))
+    assert not bad, f"{len(bad)} of {len(trials)} trials: first {bad[0]}"
