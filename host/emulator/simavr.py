@@ -125,8 +125,13 @@ def run(harness: Path, elf: Path, script: Script, timeout: float = 120) -> SimRu
                          text=True, timeout=timeout)
     if out.returncode:
         raise RuntimeError(f"harness failed ({out.returncode}): {out.stderr}{out.stdout[-500:]}")
+    return parse(out.stdout.splitlines())
+
+
+def parse(lines: list[str]) -> SimRun:
+    """The harness's event lines (see harness.c) as a SimRun."""
     r = SimRun()
-    for line in out.stdout.splitlines():
+    for line in lines:
         kind, *rest = line.split()
         if kind == "in":
             r.ins.append((int(rest[0]), int(rest[1], 16)))

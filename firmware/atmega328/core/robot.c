@@ -116,6 +116,8 @@ static void on_hello(const uint8_t *payload)
     send(PROTO_MSG_HELLO_REPLY, p, sizeof p);
 }
 
+static uint8_t catch_up_guard(void);
+
 static void on_set_drive(const struct frame *f)
 {
     struct proto_set_drive m;
@@ -133,7 +135,12 @@ static void on_set_drive(const struct frame *f)
             ;
     }
 #endif
+    /* a trip since on_frame's catch-up (the deadline of the drive before passed just now) is
+     * caught up here, with the timer interrupt held off until the deadline is restarted: none
+     * can fall between, to stop this drive after its ACK APPLIED (such a catch-up forgets this
+     * command too: a resend of it is applied again, which changes nothing but the ACK) */
     uint8_t state = board_lock();
+    catch_up_guard();
     link_heard(&link, robot.now_ms);
     board_unlock(state);
     drive_command(&robot.drive, m.left, m.right);
@@ -217,16 +224,22 @@ static void remember(const struct frame *f)
         robot.last_payload[i] = f->payload[i];
 }
 
-/* A resend of the SET_DRIVE in force is still that motion command: it refreshes the deadline. */
-static void on_resend(const struct frame *f)
+/* A resend of the SET_DRIVE in force is still that motion command: it refreshes the deadline.
+ * Returns 0 when it is no longer in force (the guard cut it since on_frame's catch-up): it is
+ * then applied again, not acknowledged as in force. */
+static uint8_t on_resend(const struct frame *f)
 {
     if (f->id == PROTO_MSG_SET_DRIVE) {
         uint8_t state = board_lock();
-        if (link.armed)
+        uint8_t armed = link.armed;
+        if (armed)
             link_heard(&link, robot.now_ms);
         board_unlock(state);
+        if (!armed)
+            return 0;
     }
     send_ack(f->seq, PROTO_ACK_RESULT_DUPLICATE); /* do not apply twice */
+    return 1;
 }
 
 /* When the guard has cut the motors, bring the drive state in line (before anything else may
@@ -260,10 +273,8 @@ static void on_frame(void *ctx, const struct frame *f)
     if (f->id == PROTO_MSG_HELLO) {
         robot.have_last = 0; /* a new session numbers its commands afresh */
     } else if (f->id != PROTO_MSG_GET_STATUS) {
-        if (is_resend(f)) {
-            on_resend(f);
+        if (is_resend(f) && on_resend(f))
             return;
-        }
         remember(f);
     }
     dispatch(f);

@@ -17,6 +17,12 @@
  *                no longer holds the pattern of fill SEED: the stack's deepest point so far
  *   reset FLAGS  reset the chip now, RAM kept (as on a real chip), MCUSR = FLAGS (hex): 0 is
  *                what the application sees behind optiboot 4.4
+ *   ticks 0|1    stop or start printing each Timer0 compare interrupt the CPU takes (the 1 kHz tick)
+ *   sweep N      the rest of the script, N times from this same state (a fork each): trial K
+ *                raises Timer0's compare interrupt once more after K instructions have run
+ *                (awake, ISRs included), so an interrupt lands at every instruction boundary of
+ *                what follows in turn, as the chip takes it (not before interrupts are on again);
+ *                the extra tick is a tick like any other (the firmware's ms clock gains one)
  * Events on stdout, times in CPU cycles since power-on:
  *   in CYCLE BYTE              a byte entered UART0 (its start bit)
  *   tx CYCLE BYTE              UART0 sent a byte
@@ -25,6 +31,10 @@
  *                              them (host/emulator/pins.py): simavr 1.6 does not report the
  *                              Timer1 PWM toggles on PB1/PB2 (docs: shared simavr notes)
  *   reset CYCLE                the chip reset (the watchdog, in these tests)
+ *   tick CYCLE                 the CPU took the Timer0 compare interrupt (with ticks 1)
+ *   force CYCLE                a sweep's trial raised its extra tick (taken when the CPU can)
+ *   trial K                    a sweep's trial K begins; the events that follow, up to its
+ *                              end line, are its own, after those printed before the sweep
  *   watchdog CYCLE ...         the datasheet's watchdog reset that simavr does not make (below)
  *   end CYCLE INS IN TX RESETS SECONDS   at the end of input
  * In --pty mode stdout has the one line "pty PATH"; the io and reset events go to stderr. */
@@ -36,6 +46,7 @@
 #include <string.h>
 #include <termios.h>
 #include <time.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <simavr/avr_uart.h>
@@ -46,6 +57,7 @@
 
 #define F_CPU 16000000UL
 #define CYCLES_PER_BYTE (10UL * F_CPU / PROTO_BAUD) /* the host's line: 10 bits a byte */
+#define TIMER0_COMPA_VECTOR 14                        /* ATmega328P interrupt vector number */
 
 /* ATmega328P data-space addresses of the watched registers (datasheet, register summary); a
  * 16-bit register is listed by its low byte and printed whole */
@@ -78,6 +90,10 @@ static struct {
     FILE *events; /* io and reset lines */
     unsigned long n_in, n_tx, resets;
     unsigned last[N_WATCHED];
+    avr_int_vector_t *tick;        /* Timer0 compare A */
+    int ticks;                     /* print each tick taken */
+    unsigned long awake, force_at; /* a sweep's trial: instructions run, when to force a tick */
+    int forcing;
 } h;
 
 static void on_tx(struct avr_irq_t *irq, uint32_t value, void *param)
@@ -189,7 +205,14 @@ static void datasheet_watchdog(void)
 static int step(void)
 {
     avr_flashaddr_t pc = h.avr->pc;
+    if (h.forcing && h.avr->state == cpu_Running && h.awake++ == h.force_at) {
+        h.forcing = 0;
+        fprintf(h.events, "force %llu %x\n", (unsigned long long)h.avr->cycle, h.avr->pc);
+        avr_raise_interrupt(h.avr, h.tick);
+    }
     int state = avr_run(h.avr);
+    if (h.ticks && h.avr->pc == TIMER0_COMPA_VECTOR * 4 && pc != h.avr->pc)
+        fprintf(h.events, "tick %llu\n", (unsigned long long)h.avr->cycle);
     if (state == cpu_Done || state == cpu_Crashed) {
         printf("crashed %llu state %d\n", (unsigned long long)h.avr->cycle, state);
         return -1;
@@ -306,6 +329,72 @@ static void reset_now(unsigned flags)
     fprintf(h.events, "reset %llu\n", (unsigned long long)h.avr->cycle);
 }
 
+static int command(const char *line);
+
+/* sweep N: run the lines that follow N times, each in a child process that starts from this
+ * state; the children run one after another, so their output does not interleave. */
+static int sweep(unsigned long n, char **rest, size_t n_rest)
+{
+    for (unsigned long k = 0; k < n; k++) {
+        fflush(stdout);
+        pid_t pid = fork();
+        if (pid < 0) {
+            perror("harness: fork");
+            return 1;
+        }
+        if (pid == 0) {
+            h.forcing = 1, h.awake = 0, h.force_at = k;
+            printf("trial %lu\n", k);
+            for (size_t i = 0; i < n_rest; i++)
+                if (command(rest[i]))
+                    _exit(1);
+            printf("end %llu %llu %lu %lu %lu 0\n", (unsigned long long)h.avr->cycle,
+                   (unsigned long long)h.avr->cycle, h.n_in, h.n_tx, h.resets);
+            fflush(stdout);
+            _exit(0);
+        }
+        int status;
+        if (waitpid(pid, &status, 0) < 0 || !WIFEXITED(status) || WEXITSTATUS(status))
+            return 1;
+    }
+    return 0;
+}
+
+/* One scripted command; non-zero ends the script (1: the firmware crashed, 2: bad input). */
+static int command(const char *line)
+{
+    char cmd[16];
+    double arg = 0;
+    unsigned flags, seed;
+    if (sscanf(line, "%15s", cmd) != 1)
+        return 0;
+    if (!strcmp(cmd, "send"))
+        queue_hex(line + 5);
+    else if (!strcmp(cmd, "quiet") && sscanf(line + 6, "%lf", &arg) == 1)
+        h.quiet = arg != 0;
+    else if (!strcmp(cmd, "flow") && sscanf(line + 5, "%lf", &arg) == 1)
+        h.flow = arg != 0;
+    else if (!strcmp(cmd, "ticks") && sscanf(line + 6, "%lf", &arg) == 1)
+        h.ticks = arg != 0;
+    else if (!strcmp(cmd, "fill") && sscanf(line + 5, "%lf", &arg) == 1)
+        fill((unsigned)arg);
+    else if (!strcmp(cmd, "stack") && sscanf(line + 6, "%u %x", &seed, &flags) == 2)
+        stack_mark(seed, flags);
+    else if (!strcmp(cmd, "poke"))
+        poke(line + 5);
+    else if (!strcmp(cmd, "reset") && sscanf(line + 6, "%x", &flags) == 1)
+        reset_now(flags);
+    else if (!strcmp(cmd, "run") && sscanf(line + 4, "%lf", &arg) == 1) {
+        if (run_until(h.avr->cycle + (avr_cycle_count_t)(arg * F_CPU / 1000)) < 0)
+            return 1;
+    } else {
+        fprintf(stderr, "harness: unknown command: %.40s\n", line);
+        return 2;
+    }
+    fflush(stdout);
+    return 0;
+}
+
 static int scripted(void)
 {
     char *line = NULL;
@@ -313,33 +402,20 @@ static int scripted(void)
     double t0 = wall();
     watch_io(); /* the registers at power-on */
     while (getline(&line, &cap, stdin) > 0) {
-        char cmd[16];
-        double arg = 0;
-        unsigned flags, seed;
-        if (sscanf(line, "%15s", cmd) != 1)
-            continue;
-        if (!strcmp(cmd, "send"))
-            queue_hex(line + 5);
-        else if (!strcmp(cmd, "quiet") && sscanf(line + 6, "%lf", &arg) == 1)
-            h.quiet = arg != 0;
-        else if (!strcmp(cmd, "flow") && sscanf(line + 5, "%lf", &arg) == 1)
-            h.flow = arg != 0;
-        else if (!strcmp(cmd, "fill") && sscanf(line + 5, "%lf", &arg) == 1)
-            fill((unsigned)arg);
-        else if (!strcmp(cmd, "stack") && sscanf(line + 6, "%u %x", &seed, &flags) == 2)
-            stack_mark(seed, flags);
-        else if (!strcmp(cmd, "poke"))
-            poke(line + 5);
-        else if (!strcmp(cmd, "reset") && sscanf(line + 6, "%x", &flags) == 1)
-            reset_now(flags);
-        else if (!strcmp(cmd, "run") && sscanf(line + 4, "%lf", &arg) == 1) {
-            if (run_until(h.avr->cycle + (avr_cycle_count_t)(arg * F_CPU / 1000)) < 0)
-                return 1;
-        } else {
-            fprintf(stderr, "harness: unknown command: %.40s\n", line);
-            return 2;
+        unsigned long n;
+        if (sscanf(line, "sweep %lu", &n) == 1) {
+            char **rest = NULL;
+            size_t n_rest = 0;
+            while (getline(&line, &cap, stdin) > 0) {
+                rest = realloc(rest, ++n_rest * sizeof *rest);
+                if (!rest || !(rest[n_rest - 1] = strdup(line)))
+                    return 1;
+            }
+            return sweep(n, rest, n_rest);
         }
-        fflush(stdout);
+        int r = command(line);
+        if (r)
+            return r;
     }
     free(line);
     printf("end %llu %llu %lu %lu %lu %.3f\n", (unsigned long long)h.avr->cycle,
@@ -410,6 +486,13 @@ int main(int argc, char **argv)
         h.last[i] = ~0u; /* the first step prints the registers at power-on */
     uint32_t flags = 0; /* no console echo of UART output */
     avr_ioctl(h.avr, AVR_IOCTL_UART_SET_FLAGS('0'), &flags);
+    for (int i = 0; i < h.avr->interrupts.vector_count; i++)
+        if (h.avr->interrupts.vector[i]->vector == TIMER0_COMPA_VECTOR)
+            h.tick = h.avr->interrupts.vector[i];
+    if (!h.tick) {
+        fprintf(stderr, "harness: no Timer0 compare vector\n");
+        return 2;
+    }
     h.uart_in = avr_io_getirq(h.avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_INPUT);
     avr_irq_register_notify(avr_io_getirq(h.avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUTPUT),
                             on_tx, NULL);
