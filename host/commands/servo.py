@@ -24,6 +24,7 @@ from host.commands.options import (
     params_from_args,
 )
 from host.commands.servo_outcome import outcome, replay_outcome
+from host.commands.swap_check import check_recorded
 from host.commands.view import add_view_option, hold_view, open_view
 from host.errors import HostError, NotReached, RecordingEnded
 from host.files import check_folder, check_output
@@ -179,7 +180,7 @@ def run(args: argparse.Namespace) -> int:
         # the port first: a wrong one fails before a camera is opened
         link = stack.enter_context(RobotLink(service.path if service else args.port,
                                              drive_budget_s=SERVO_DRIVE_BUDGET_S))
-        source = stack.enter_context(open_source(args))
+        source = check_recorded(args, stack.enter_context(open_source(args)))
         geometry = source_geometry(args, source)
         clock = getattr(source, "clock", time.monotonic)  # a bag's own clock (its stamps)
         servo = Servo(source, link, params, geometry, _control(args), marker=args.marker,

@@ -12,6 +12,7 @@ from collections.abc import Iterator
 
 from host.camera.open import add_camera_options, open_source, source_geometry
 from host.commands.options import POSITIVE, add_matcher_options, params_from_args
+from host.commands.swap_check import check_recorded
 from host.errors import HostError
 from host.record import add_record_options, check_record, recording
 from host.servo.marker import find_marker
@@ -95,7 +96,7 @@ def run(args: argparse.Namespace) -> int:
     params = params_from_args(args)
     check_record(args)
     with contextlib.ExitStack() as stack:
-        source = stack.enter_context(open_source(args))
+        source = check_recorded(args, stack.enter_context(open_source(args)))
         geometry = source_geometry(args, source)
         view = stack.enter_context(open_view(args.view, wait=args.view_wait))
         observers = [view.feed]
