@@ -12,6 +12,7 @@ import time
 from pathlib import Path
 
 from host.camera.open import add_camera_options, open_source, parse_size, source_geometry
+from host.commands.held_signals import signals_held
 from host.commands.options import (
     COUNT,
     FRACTION,
@@ -317,10 +318,11 @@ def _run_servo(args, servo, geometry, world, clock) -> int:
     finally:
         status.done()
         if servo.rows:
-            if args.log:
-                write_csv(args.log, servo.rows)
-            if args.plot:
-                plot_run(args.plot, servo.rows, geometry)
+            with signals_held():  # a second Ctrl-C does not cut the log or the plot short
+                if args.log:
+                    write_csv(args.log, servo.rows)
+                if args.plot:
+                    plot_run(args.plot, servo.rows, geometry)
     ended = end.how == ENDED
     failed, msg = replay_outcome(servo, servo.source) if ended else outcome(servo)
     if world is not None:
