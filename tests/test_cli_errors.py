@@ -83,6 +83,7 @@ def files(tmp_path: Path) -> dict[str, Path]:
     f["replay"].mkdir()
     cv2.imwrite(str(f["replay"] / "left_000.png"), grey)
     cv2.imwrite(str(f["replay"] / "right_000.png"), grey)
+    f["swapped"] = _swapped_replay(tmp_path / "swapped")
     f["l16"] = tmp_path / "l16.png"
     cv2.imwrite(str(f["l16"]), grey.astype(np.uint16) * 256)
     h, w = grey.shape
@@ -106,6 +107,18 @@ def files(tmp_path: Path) -> dict[str, Path]:
     f["ros_equi"].write_text("image_width: 160\nimage_height: 120\ncamera_matrix: {}\n"
                              "distortion_model: equidistant\n")
     return f
+
+
+def _swapped_replay(folder: Path) -> Path:
+    """A replay of the simulated world with its left and right views exchanged."""
+    from host.sim.renderer import Renderer
+    from host.sim.world import World
+
+    folder.mkdir()
+    pair = Renderer(World.for_size(320, 240)).frame(with_robot=True)
+    cv2.imwrite(str(folder / "left_000.png"), pair.right)
+    cv2.imwrite(str(folder / "right_000.png"), pair.left)
+    return folder
 
 
 def _scene_2014(folder: Path, grey: np.ndarray, pfm: bytes, calib: str | None = None) -> Path:
@@ -221,6 +234,12 @@ ROWS = [
     (SERVO + ["--calib", "a,b,c"], "--calib a,b,c: give one OpenCV file, or two ROS"),
     (SERVO + ["--calib", "{calib_ocv},{ros_equi}"], "calib.yml is an OpenCV stereo calibration"),
     (SERVO + ["--calib", "{ros_equi},{ros_equi}"], "distortion_model 'equidistant' is not"),
+    # a replay whose left and right are swapped: refused before the robot moves
+    (["servo", "--camera", "replay:{swapped}", "--port", "emulator"],
+     "replay:{swapped}: left and right look swapped (median disparity -"),
+    (["view", "--camera", "replay:{swapped}"], "replay:{swapped}: left and right look swapped"),
+    (["tune", "--camera", "replay:{swapped}", "--objective", "self"],
+     "replay-0: left and right look swapped"),
     # cameras: a sysfs root that is not there
     (["cameras", "--sysfs", "{tmp}/missing"], "--sysfs {tmp}/missing: no such folder"),
     # Ray: an address where nothing listens answers at once (loopback only)

@@ -66,3 +66,41 @@ def test_a_signal_ends_the_emulator_with_128_plus_n(tmp_path: Path, signum: int)
     assert proc.returncode == 128 + signum, err
     name = "" if signum == signal.SIGINT else f" ({signal.Signals(signum).name})"
     assert err.splitlines()[-1] == f"host emulate: interrupted{name}"
+
+
+def _run_with_a_ctrl_c_in_the_plot(tmp_path: Path, monkeypatch, during_run: bool) -> int:
+    """host servo --sim --log --plot, a Ctrl-C arriving as the plot starts (and, during_run,
+    another that ended the run): the exit status."""
+    import dataclasses
+
+    import host.commands.servo as servo_cmd
+    from host.cli import main
+
+    real_plot, real_run = servo_cmd.plot_run, servo_cmd.run_servo
+
+    def plot(*a, **kw):
+        os.kill(os.getpid(), signal.SIGINT)  # handled here, before the plot is written
+        real_plot(*a, **kw)
+
+    def run(servo, rules, *a, **kw):
+        real_run(servo, dataclasses.replace(rules, duration_s=0.5, settle_s=0), *a, **kw)
+        raise KeyboardInterrupt  # the first Ctrl-C, during the run
+
+    monkeypatch.setattr(servo_cmd, "plot_run", plot)
+    if during_run:
+        monkeypatch.setattr(servo_cmd, "run_servo", run)
+    return main(["servo", "--sim", "--border", "clip", "--num-disp", "48", "--duration", "0.5",
+                 "--settle", "0", "--log", str(tmp_path / "run.csv"),
+                 "--plot", str(tmp_path / "run.png")])
+
+
+@pytest.mark.parametrize("during_run", [False, True])
+def test_a_ctrl_c_while_the_plot_is_written_keeps_it_whole(tmp_path: Path, monkeypatch, capsys,
+                                                           during_run: bool) -> None:
+    code = _run_with_a_ctrl_c_in_the_plot(tmp_path, monkeypatch, during_run)
+    assert code == 130
+    assert capsys.readouterr().err.splitlines()[-1] == "host servo: interrupted"
+    png = (tmp_path / "run.png").read_bytes()
+    assert png.startswith(b"\x89PNG") and png.endswith(b"IEND\xaeB`\x82")
+    assert (tmp_path / "run.csv").read_text().startswith("t,phase")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.csv", "run.png"]

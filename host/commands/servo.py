@@ -12,6 +12,7 @@ import time
 from pathlib import Path
 
 from host.camera.open import add_camera_options, open_source, parse_size, source_geometry
+from host.commands.held_signals import signals_held
 from host.commands.options import (
     COUNT,
     FRACTION,
@@ -24,6 +25,7 @@ from host.commands.options import (
     params_from_args,
 )
 from host.commands.servo_outcome import outcome, replay_outcome
+from host.commands.swap_check import check_recorded
 from host.commands.view import add_view_option, hold_view, open_view
 from host.errors import HostError, NotReached, RecordingEnded
 from host.files import check_folder, check_output
@@ -179,7 +181,7 @@ def run(args: argparse.Namespace) -> int:
         # the port first: a wrong one fails before a camera is opened
         link = stack.enter_context(RobotLink(service.path if service else args.port,
                                              drive_budget_s=SERVO_DRIVE_BUDGET_S))
-        source = stack.enter_context(open_source(args))
+        source = check_recorded(args, stack.enter_context(open_source(args)))
         geometry = source_geometry(args, source)
         clock = getattr(source, "clock", time.monotonic)  # a bag's own clock (its stamps)
         servo = Servo(source, link, params, geometry, _control(args), marker=args.marker,
@@ -316,10 +318,11 @@ def _run_servo(args, servo, geometry, world, clock) -> int:
     finally:
         status.done()
         if servo.rows:
-            if args.log:
-                write_csv(args.log, servo.rows)
-            if args.plot:
-                plot_run(args.plot, servo.rows, geometry)
+            with signals_held():  # a second Ctrl-C does not cut the log or the plot short
+                if args.log:
+                    write_csv(args.log, servo.rows)
+                if args.plot:
+                    plot_run(args.plot, servo.rows, geometry)
     ended = end.how == ENDED
     failed, msg = replay_outcome(servo, servo.source) if ended else outcome(servo)
     if world is not None:

@@ -22,6 +22,7 @@ from host.commands.options import (
     int_range,
     params_from_args,
 )
+from host.commands.swap_check import check_pairs
 from host.errors import HostError
 from host.files import all_or_nothing, check_output
 from host.params_file import save_params
@@ -212,6 +213,8 @@ def run(args: argparse.Namespace) -> int:
         if s.gt is None and args.objective == "gt":
             raise HostError(f"{s.name}: no ground truth to tune against "
                             "(--objective self needs none)")
+    if args.objective == "self":
+        check_pairs([(s.name, s.left, s.right) for s in scenes], args.swap_check)
     n_tune = len(scenes) if args.tune_on is None else args.tune_on
     if not 1 <= n_tune <= len(scenes):
         raise HostError(f"--tune-on must be 1..{len(scenes)}, got {args.tune_on}")

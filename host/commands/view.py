@@ -10,8 +10,9 @@ import sys
 import time
 from collections.abc import Iterator
 
-from host.camera.open import add_camera_options, open_source, source_geometry
+from host.camera.open import add_camera_options, open_source, parse_size, source_geometry
 from host.commands.options import POSITIVE, add_matcher_options, params_from_args
+from host.commands.swap_check import check_recorded
 from host.errors import HostError
 from host.record import add_record_options, check_record, recording
 from host.servo.marker import find_marker
@@ -86,17 +87,37 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     add_view_option(p, default="127.0.0.1:0")
     p.add_argument("--duration", type=POSITIVE, metavar="S", help="stop after S seconds")
     add_camera_options(p)
+    camera = next(a for a in p._actions if a.dest == "camera")
+    camera.help = (camera.help or "") + "; or sim: the simulated world, as host servo --sim sees it"
     add_matcher_options(p)
     add_record_options(p)
     p.set_defaults(run=run)
+
+
+@contextlib.contextmanager
+def _sim(args: argparse.Namespace) -> Iterator[tuple[object, object]]:
+    """--camera sim: the simulated world's camera (the robot standing at its start) at --speed
+    times real time (default 1, 0 as fast as it goes), and its geometry."""
+    from host.camera.paced import PacedSource
+    from host.sim.run import Setup, simulation
+
+    if args.calib:
+        raise HostError("--camera sim is the simulated camera, rectified already: no --calib")
+    with simulation(Setup(parse_size(args.size)), reference=False) as sim:
+        speed = 1.0 if args.speed is None else args.speed
+        source = PacedSource(sim.source, speed) if speed > 0 else sim.source
+        yield source, sim.servo.geometry
 
 
 def run(args: argparse.Namespace) -> int:
     params = params_from_args(args)
     check_record(args)
     with contextlib.ExitStack() as stack:
-        source = stack.enter_context(open_source(args))
-        geometry = source_geometry(args, source)
+        if args.camera == "sim":
+            source, geometry = stack.enter_context(_sim(args))
+        else:
+            source = check_recorded(args, stack.enter_context(open_source(args)))
+            geometry = source_geometry(args, source)
         view = stack.enter_context(open_view(args.view, wait=args.view_wait))
         observers = [view.feed]
         rec = stack.enter_context(recording(args, time.monotonic))
