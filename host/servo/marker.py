@@ -35,21 +35,36 @@ class MarkerPair:
         return self.left.u - self.right.u
 
 
+def _p90(patch: np.ndarray) -> float:
+    """np.percentile(patch, 90) of a uint8 array, exactly (its linear interpolation between
+    the order statistics on each side), from the histogram instead of a partition."""
+    n = patch.size
+    q = (n - 1) * 0.9
+    lo = math.floor(q)
+    hi = min(lo + 1, n - 1)
+    order = np.cumsum(np.bincount(patch.ravel(), minlength=256))
+    a, b = (float(np.searchsorted(order, k, side="right")) for k in (lo, hi))
+    gamma = q - lo
+    diff = b - a
+    return b - diff * (1 - gamma) if gamma >= 0.5 else a + diff * gamma
+
+
 def _centroid(grey: np.ndarray, cx: float, cy: float, r: float) -> tuple[float, float]:
     """Darkness-weighted centroid within 1.3 r (the disc plus a band of ring), sub-pixel."""
     h, w = grey.shape
     x0, x1 = max(0, int(cx - 1.3 * r) - 1), min(w, int(cx + 1.3 * r) + 2)
     y0, y1 = max(0, int(cy - 1.3 * r) - 1), min(h, int(cy + 1.3 * r) + 2)
-    patch = grey[y0:y1, x0:x1].astype(np.float64)
-    ring = np.percentile(patch, 90)
-    weight = np.clip(ring - patch, 0, None)
-    ys, xs = np.mgrid[y0:y1, x0:x1]
-    inside = (xs - cx) ** 2 + (ys - cy) ** 2 <= (1.3 * r) ** 2
+    raw = grey[y0:y1, x0:x1]
+    weight = _p90(raw) - raw.astype(np.float64)
+    np.maximum(weight, 0.0, out=weight)
+    xs, ys = np.arange(x0, x1), np.arange(y0, y1)
+    inside = ((xs - cx) ** 2)[None, :] + ((ys - cy) ** 2)[:, None] <= (1.3 * r) ** 2
     weight *= inside
     total = weight.sum()
     if total <= 0:
         return cx, cy
-    return float((weight * xs).sum() / total), float((weight * ys).sum() / total)
+    # the same products in the same contiguous arrays as with np.mgrid's grids: the same sums
+    return float((weight * xs).sum() / total), float((weight * ys[:, None]).sum() / total)
 
 
 def find_discs(image: np.ndarray, min_radius: float = 2.5, max_radius: float = 80.0,
@@ -63,11 +78,20 @@ def find_discs(image: np.ndarray, min_radius: float = 2.5, max_radius: float = 8
     mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, np.ones((2, 2), np.uint8))
     blobs = []
     min_area = math.pi * min_radius ** 2
-    for c in _outlines(mask, min_area):
-        # the cheapest tests first; the contour's area is at most (w - 1)(h - 1)
-        x, y, w, h = cv2.boundingRect(c)
-        if not 0.75 < w / h < 1.33 or (w - 1) * (h - 1) < min_area:
-            continue
+    outlines = _outlines(mask, min_area)
+    if not outlines:
+        return blobs
+    # the cheapest tests first, on every outline at once: its bounding box's aspect, and the
+    # contour's area is at most (w - 1)(h - 1) (cv2.boundingRect's box, from the points)
+    ends = np.cumsum([len(c) for c in outlines])
+    points = np.concatenate(outlines).reshape(-1, 2)
+    starts = ends - np.array([len(c) for c in outlines])
+    lo, hi = np.minimum.reduceat(points, starts), np.maximum.reduceat(points, starts)
+    bw, bh = hi[:, 0] - lo[:, 0] + 1, hi[:, 1] - lo[:, 1] + 1
+    keep = (bw / bh > 0.75) & (bw / bh < 1.33) & ((bw - 1) * (bh - 1) >= min_area)
+    for i in np.flatnonzero(keep):
+        c = outlines[i]
+        x, y, w, h = int(lo[i, 0]), int(lo[i, 1]), int(bw[i]), int(bh[i])
         area = cv2.contourArea(c)
         if area < min_area or area > math.pi * max_radius ** 2:
             continue
@@ -76,10 +100,17 @@ def find_discs(image: np.ndarray, min_radius: float = 2.5, max_radius: float = 8
             continue
         r = (w + h) / 4
         u, v = _centroid(grey, x + (w - 1) / 2, y + (h - 1) / 2, r)
-        ring, ring_sd = _annulus_stats(grey, u, v, 1.2 * r, 1.45 * r)
-        disc, disc_sd = _annulus_stats(grey, u, v, 0.0, 0.7 * r)
-        # printed: a uniform light ring round a uniform dark disc (texture is neither)
-        if ring - disc < 80 or max(ring_sd, disc_sd) > 0.2 * (ring - disc):
+        ring_px = _annulus(grey, u, v, 1.2 * r, 1.45 * r)
+        disc_px = _annulus(grey, u, v, 0.0, 0.7 * r)
+        # printed: a uniform light ring round a uniform dark disc (texture is neither); the
+        # means first (exact from the integer sums), the deviations only if they pass
+        ring = _mean(ring_px) if ring_px.size else 0.0
+        disc = _mean(disc_px) if disc_px.size else 0.0
+        if ring - disc < 80:
+            continue
+        ring_sd = float(ring_px.astype(np.float64).std()) if ring_px.size else 255.0
+        disc_sd = float(disc_px.astype(np.float64).std()) if disc_px.size else 255.0
+        if max(ring_sd, disc_sd) > 0.2 * (ring - disc):
             continue
         m = cv2.moments(c)
         aspect = math.sqrt(m["mu20"] / m["mu02"]) if m["mu02"] > 0 else 1.0
@@ -96,19 +127,18 @@ def _outlines(mask: np.ndarray, min_area: float) -> list[np.ndarray]:
     return [c for c in contours if len(c) >= shortest]
 
 
-def _annulus_stats(grey: np.ndarray, cx: float, cy: float, r0: float, r1: float
-                   ) -> tuple[float, float]:
-    """Mean and standard deviation of the grey levels between radii r0 and r1."""
+def _annulus(grey: np.ndarray, cx: float, cy: float, r0: float, r1: float) -> np.ndarray:
+    """The grey levels between radii r0 and r1 (uint8, in row order)."""
     h, w = grey.shape
     x0, x1 = max(0, int(cx - r1) - 1), min(w, int(cx + r1) + 2)
     y0, y1 = max(0, int(cy - r1) - 1), min(h, int(cy + r1) + 2)
-    ys, xs = np.mgrid[y0:y1, x0:x1]
-    d2 = (xs - cx) ** 2 + (ys - cy) ** 2
-    sel = (d2 >= r0 * r0) & (d2 <= r1 * r1)
-    if not sel.any():
-        return 0.0, 255.0
-    values = grey[y0:y1, x0:x1][sel].astype(np.float64)
-    return float(values.mean()), float(values.std())
+    d2 = ((np.arange(x0, x1) - cx) ** 2)[None, :] + ((np.arange(y0, y1) - cy) ** 2)[:, None]
+    return grey[y0:y1, x0:x1][(d2 >= r0 * r0) & (d2 <= r1 * r1)]
+
+
+def _mean(values: np.ndarray) -> float:
+    """values.astype(float).mean() of uint8 values, exactly: their sum is an integer."""
+    return int(values.sum(dtype=np.int64)) / values.size
 
 
 def find_aruco(image: np.ndarray) -> list[Blob]:

@@ -13,8 +13,9 @@ chessboards recovers it as it would a real lens.
 Speed: a sensor's grey level is a function of the ideal view's at that pixel alone, so with no
 pitch, flicker or lens the bare scene's sensor image is made once per layout and noise field,
 and each view sends only the rectangles drawn over (robot, marker, blur, people) through the
-sensor again; the images are bit-identical to the full computation
-(tests/sim/test_render_speedup.py).
+sensor again; with a lens (no pitch or flicker) the same, and only the pixels whose source
+pixels meet that rectangle go through remap() again. The images are bit-identical to the full
+computation (tests/sim/test_render_speedup.py).
 """
 
 from __future__ import annotations
@@ -307,6 +308,8 @@ class Renderer:
                 blur = blur_px if thing is world.robot else (0.0, 0.0)
                 self._draw_robot(img, disp, float(side), blur, thing)
         k = self._noise_field(side)
+        if not self.pitch_deg and self.flicker is None and self._lens[side] is not None:
+            return self._through_lens(img, side, k), disp
         if not self.pitch_deg and self.flicker is None and self._lens[side] is None:
             # each pixel's grey level is a function of the ideal view's there alone: the scene's
             # pixels come from the sensor's image of the bare scene with this noise field, and
@@ -371,6 +374,50 @@ class Renderer:
         np.rint(img, out=img)
         np.clip(img, 0, 255, out=img)
         return img.astype(np.uint8)
+
+    def _before_lens(self, img: np.ndarray, side: int, k: int | None,
+                     region: tuple[int, int, int, int] | None = None) -> np.ndarray:
+        """_sensor's arithmetic up to the lens (float32): gain, black level, noise field k,
+        white balance; pixel by pixel the same for a region as for the whole view."""
+        cam = self.camera
+        img = np.multiply(img, cam.gain[side])
+        np.add(img, cam.bias[side], out=img)
+        if k is not None:
+            noise = self._noise[k]
+            img += noise if region is None else noise[region[0]:region[1], region[2]:region[3]]
+        if cam.white:
+            img = img[..., None] * np.asarray(cam.white[side], np.float32)
+        return img.astype(np.float32, copy=False)
+
+    def _through_lens(self, img: np.ndarray, side: int, k: int | None) -> np.ndarray:
+        """_sensor(img) with a lens (no pitch, flicker), from the bare scene's image: remap()
+        makes each pixel from its map's entry and the 2x2 source pixels there alone, so only
+        the pixels whose source meets the rectangle drawn over are remapped again."""
+        out = self._bare(side, k).copy()
+        if not self._touched:
+            return out
+        r0, r1, c0, c1 = (f(t[i] for t in self._touched)
+                          for i, f in enumerate((min, max, min, max)))
+        key = ("before lens", side, k)
+        if key not in self._bare_images:
+            self._bare_images[key] = self._before_lens(self._static[side][0], side, k)
+        src = self._bare_images[key].copy()
+        src[r0:r1, c0:c1] = self._before_lens(img[r0:r1, c0:c1], side, k, (r0, r1, c0, c1))
+        mx, my = self._lens[side]
+        # a source pixel on the image's edge also stands for the ones beyond it (replicated)
+        h, w = mx.shape
+        lo_x, hi_x = (-math.inf if c0 == 0 else c0 - 2), (math.inf if c1 >= w else c1 + 1)
+        lo_y, hi_y = (-math.inf if r0 == 0 else r0 - 2), (math.inf if r1 >= h else r1 + 1)
+        hit = (mx > lo_x) & (mx < hi_x) & (my > lo_y) & (my < hi_y)
+        rows, cols = np.flatnonzero(hit.any(1)), np.flatnonzero(hit.any(0))
+        if not rows.size:
+            return out
+        y0, y1, x0, x1 = int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1
+        part = cv2.remap(src, mx[y0:y1, x0:x1], my[y0:y1, x0:x1], cv2.INTER_LINEAR,
+                         borderMode=cv2.BORDER_REPLICATE)
+        cv2.max(part, 0.0, dst=part)
+        out[y0:y1, x0:x1] = cv2.convertScaleAbs(part)
+        return out
 
     def _bare(self, side: int, k: int | None) -> np.ndarray:
         """The sensor's image (no pitch, flicker or lens) of the bare scene with noise field k,

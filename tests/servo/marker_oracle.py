@@ -1,0 +1,212 @@
+"""The robot's marker as host.servo.marker found it at edcebe3, before it was made faster: the
+frozen oracle tests/servo/test_marker_speedup.py compares the faster search with (do not edit).
+
+The marker: a dark disc inside a light ring (ring radius 1.7 x disc radius), printed
+on both sides of a card on a mast, so that it shows whether the robot faces the camera or not.
+ArUco (DICT_4X4_50, cv2.aruco.ArucoDetector) is the alternative.
+
+Centres are sub-pixel: the intensity-weighted centroid of the disc's darkness. The robot's
+disparity is the difference of the matched left and right centres (rectified: same row).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from host.stereo.grey import to_grey
+
+
+@dataclass(frozen=True)
+class Blob:
+    u: float  # column, px
+    v: float  # row, px
+    radius: float  # px (vertical semi-axis of the disc)
+    aspect: float = 1.0  # width / height of the disc: |cos| of the card's angle to the camera
+
+
+@dataclass(frozen=True)
+class MarkerPair:
+    left: Blob
+    right: Blob
+
+    @property
+    def disparity(self) -> float:
+        return self.left.u - self.right.u
+
+
+def _centroid(grey: np.ndarray, cx: float, cy: float, r: float) -> tuple[float, float]:
+    """Darkness-weighted centroid within 1.3 r (the disc plus a band of ring), sub-pixel."""
+    h, w = grey.shape
+    x0, x1 = max(0, int(cx - 1.3 * r) - 1), min(w, int(cx + 1.3 * r) + 2)
+    y0, y1 = max(0, int(cy - 1.3 * r) - 1), min(h, int(cy + 1.3 * r) + 2)
+    patch = grey[y0:y1, x0:x1].astype(np.float64)
+    ring = np.percentile(patch, 90)
+    weight = np.clip(ring - patch, 0, None)
+    ys, xs = np.mgrid[y0:y1, x0:x1]
+    inside = (xs - cx) ** 2 + (ys - cy) ** 2 <= (1.3 * r) ** 2
+    weight *= inside
+    total = weight.sum()
+    if total <= 0:
+        return cx, cy
+    return float((weight * xs).sum() / total), float((weight * ys).sum() / total)
+
+
+def find_discs(image: np.ndarray, min_radius: float = 2.5, max_radius: float = 80.0,
+               window: int = 31) -> list[Blob]:
+    """Dark, round blobs inside a lighter ring; window (px, odd) is the neighbourhood the disc
+    is darker than, and must be wider than the disc (find_marker sizes it)."""
+    grey = to_grey(image)
+    # dark relative to the neighbourhood: the ring makes the disc stand out locally
+    local = cv2.blur(grey, (window, window))
+    mask = (grey.astype(np.int16) < local.astype(np.int16) - 40).astype(np.uint8)
+    mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, np.ones((2, 2), np.uint8))
+    blobs = []
+    min_area = math.pi * min_radius ** 2
+    for c in _outlines(mask, min_area):
+        # the cheapest tests first; the contour's area is at most (w - 1)(h - 1)
+        x, y, w, h = cv2.boundingRect(c)
+        if not 0.75 < w / h < 1.33 or (w - 1) * (h - 1) < min_area:
+            continue
+        area = cv2.contourArea(c)
+        if area < min_area or area > math.pi * max_radius ** 2:
+            continue
+        perimeter = cv2.arcLength(c, True)
+        if perimeter <= 0 or 4 * math.pi * area / perimeter ** 2 < 0.7:
+            continue
+        r = (w + h) / 4
+        u, v = _centroid(grey, x + (w - 1) / 2, y + (h - 1) / 2, r)
+        ring, ring_sd = _annulus_stats(grey, u, v, 1.2 * r, 1.45 * r)
+        disc, disc_sd = _annulus_stats(grey, u, v, 0.0, 0.7 * r)
+        # printed: a uniform light ring round a uniform dark disc (texture is neither)
+        if ring - disc < 80 or max(ring_sd, disc_sd) > 0.2 * (ring - disc):
+            continue
+        m = cv2.moments(c)
+        aspect = math.sqrt(m["mu20"] / m["mu02"]) if m["mu02"] > 0 else 1.0
+        blobs.append(Blob(u, v, r, aspect))
+    return blobs
+
+
+def _outlines(mask: np.ndarray, min_area: float) -> list[np.ndarray]:
+    """The outer contours of the mask's blobs that could enclose min_area px: a textured scene
+    leaves thousands of specks. A closed contour of n points (steps of at most sqrt 2 px)
+    encloses at most (n sqrt 2)^2 / (4 pi) px, so shorter ones are dropped unmeasured."""
+    contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    shortest = math.sqrt(2 * math.pi * min_area)
+    return [c for c in contours if len(c) >= shortest]
+
+
+def _annulus_stats(grey: np.ndarray, cx: float, cy: float, r0: float, r1: float
+                   ) -> tuple[float, float]:
+    """Mean and standard deviation of the grey levels between radii r0 and r1."""
+    h, w = grey.shape
+    x0, x1 = max(0, int(cx - r1) - 1), min(w, int(cx + r1) + 2)
+    y0, y1 = max(0, int(cy - r1) - 1), min(h, int(cy + r1) + 2)
+    ys, xs = np.mgrid[y0:y1, x0:x1]
+    d2 = (xs - cx) ** 2 + (ys - cy) ** 2
+    sel = (d2 >= r0 * r0) & (d2 <= r1 * r1)
+    if not sel.any():
+        return 0.0, 255.0
+    values = grey[y0:y1, x0:x1][sel].astype(np.float64)
+    return float(values.mean()), float(values.std())
+
+
+def find_aruco(image: np.ndarray) -> list[Blob]:
+    detector = cv2.aruco.ArucoDetector(cv2.aruco.getPredefinedDictionary(cv2.aruco.DICT_4X4_50))
+    corners, ids, _ = detector.detectMarkers(to_grey(image))
+    out = []
+    for c in corners:
+        pts = np.asarray(c).reshape(-1, 2)
+        out.append(Blob(float(pts[:, 0].mean()), float(pts[:, 1].mean()),
+                        float(np.linalg.norm(pts[0] - pts[2]) / 2.8)))
+    return out
+
+
+def find_markers(left: np.ndarray, right: np.ndarray, kind: str = "disc",
+                 max_row_error: float = 2.0, windows: tuple | None = None, window: int = 31
+                 ) -> list[MarkerPair]:
+    """Candidate marker pairs in a rectified pair: a left blob and a right blob on the same row
+    to its left (positive disparity) with a similar size. windows: ((x0, y0, x1, y1) left,
+    (x0, y0, x1, y1) right) to search in, else the whole images."""
+    def find(img: np.ndarray) -> list[Blob]:
+        return find_aruco(img) if kind == "aruco" else find_discs(img, window=window)
+
+    found: list[list[Blob]] = []
+    for img, win in zip((left, right), windows or (None, None)):
+        if found and not found[0]:
+            return []  # nothing on the left: no pair, whatever the right view holds
+        if win is None:
+            found.append(find(img))
+            continue
+        x0, y0, x1, y1 = win
+        found.append([Blob(b.u + x0, b.v + y0, b.radius, b.aspect)
+                      for b in find(img[y0:y1, x0:x1])])
+    pairs = []
+    for a in found[0]:
+        for b in found[1]:
+            if (abs(a.v - b.v) <= max_row_error and a.u - b.u > 0
+                    and abs(a.radius - b.radius) <= 0.3 * a.radius + 1):
+                pairs.append(MarkerPair(a, b))
+    return pairs
+
+
+def _window(blob: Blob, shape: tuple[int, ...]) -> tuple[int, int, int, int]:
+    reach = int(4 * blob.radius) + 24  # room for the frame-to-frame motion
+    h, w = shape[:2]
+    return (max(0, int(blob.u) - reach), max(0, int(blob.v) - reach),
+            min(w, int(blob.u) + reach + 1), min(h, int(blob.v) + reach + 1))
+
+
+def marker_candidates(left: np.ndarray, right: np.ndarray, kind: str = "disc",
+                      radius_m: float | None = None, baseline_m: float | None = None,
+                      near: MarkerPair | None = None, whole: bool = False) -> list[MarkerPair]:
+    """Marker pairs whose size fits their distance (a disc of radius_m at disparity d spans
+    radius_m * d / baseline_m px; within 35%), best first: nearest to the last sighting `near`
+    (searched for around it first, unless whole), else the largest. The neighbourhood the
+    disc must be darker than grows with the disc: from the last sighting, or at 31 px and then,
+    if nothing is found, 121 px (a marker near the camera)."""
+    def fits(p: MarkerPair) -> bool:
+        if radius_m is None or baseline_m is None:
+            return True
+        expected = radius_m * p.disparity / baseline_m
+        return abs(p.left.radius - expected) <= 0.35 * expected
+
+    pairs = []
+    if near is not None and not whole:
+        windows = (_window(near.left, left.shape), _window(near.right, right.shape))
+        size = max(31, 2 * int(3 * near.left.radius) + 1)
+        pairs = [p for p in find_markers(left, right, kind, windows=windows, window=size)
+                 if fits(p)]
+    for size in (31, 121):
+        if pairs:
+            break
+        pairs = [p for p in find_markers(left, right, kind, window=size) if fits(p)]
+    if near is not None:
+        return sorted(pairs, key=lambda p: abs(p.left.u - near.left.u)
+                      + abs(p.left.v - near.left.v) + 10 * abs(p.disparity - near.disparity))
+    return sorted(pairs, key=lambda p: -p.left.radius)
+
+
+def find_marker(left: np.ndarray, right: np.ndarray, kind: str = "disc",
+                radius_m: float | None = None, baseline_m: float | None = None,
+                near: MarkerPair | None = None) -> MarkerPair | None:
+    """The best of marker_candidates, None if there is none."""
+    pairs = marker_candidates(left, right, kind, radius_m, baseline_m, near)
+    return pairs[0] if pairs else None
+
+
+def block_disparity(disp: np.ndarray, blob: Blob) -> float:
+    """Median block-matching disparity over the marker's ring (its textured part), NaN if none."""
+    h, w = disp.shape
+    r = blob.radius
+    x0, x1 = max(0, int(blob.u - 1.6 * r)), min(w, int(blob.u + 1.6 * r) + 1)
+    y0, y1 = max(0, int(blob.v - 1.6 * r)), min(h, int(blob.v + 1.6 * r) + 1)
+    ys, xs = np.mgrid[y0:y1, x0:x1]
+    d2 = (xs - blob.u) ** 2 + (ys - blob.v) ** 2
+    sel = (d2 >= (0.7 * r) ** 2) & (d2 <= (1.6 * r) ** 2)
+    values = disp[y0:y1, x0:x1][sel]
+    values = values[np.isfinite(values)]
+    return float(np.median(values)) if values.size else float("nan")
