@@ -75,3 +75,14 @@ def test_the_depth_must_move_the_way_the_robot_is_driven(facing_away: bool, dz: 
         est.accept(sighting(t + 1 / 30, z))
         got = got or est.motion(t + 1 / 30, 500, 500, facing_away, True)
     assert got == want
+
+
+@pytest.mark.parametrize("disparity", [-16.0, 0.0, 2.0, 200.0])
+def test_a_first_sighting_at_no_depth_a_robot_can_be_at_is_refused(disparity: float) -> None:
+    """With no state yet (a re-acquisition after a look-alike was left out), a skew correction
+    across the jump from the look-alike to the robot made a disparity of -16 px: taken as the
+    first sighting, it made every true one 3.4 m "from where the robot can be" (seed 4, trial
+    34: the run stopped with that reason while the robot stood in view at 2.8 m)."""
+    est = Estimator(G)
+    assert "no depth a robot can be at" in est.gate(Sighting(0.0, disparity, G.cx, 10.0))
+    assert est.gate(sighting(0.0, 2.8)) == ""
