@@ -86,3 +86,18 @@ def test_a_first_sighting_at_no_depth_a_robot_can_be_at_is_refused(disparity: fl
     est = Estimator(G)
     assert "no depth a robot can be at" in est.gate(Sighting(0.0, disparity, G.cx, 10.0))
     assert est.gate(sighting(0.0, 2.8)) == ""
+
+
+def test_the_skew_correction_does_not_follow_a_jump_to_another_marker() -> None:
+    """The skew correction moves the right centre back by its image speed times the skew; from
+    a look-alike at u = 247 to the robot 90 px away in a frame, that 'speed' made -16 px of a
+    24 px disparity (seed 4, trial 34). A robot's own motion moves its image slowly: a small
+    correction is still made, one beyond a fifth of the disparity is not."""
+    from host.servo.timing import FrameTiming
+
+    timing = FrameTiming()
+    timing.skew_free(0.0, 0.022, 15.0, 232.0)  # the look-alike
+    assert timing.skew_free(1 / 30, 1 / 30 + 0.022, 24.0, 142.0) == 24.0
+    timing.skew_free(2 / 30, 2 / 30 + 0.022, 24.0, 142.0)
+    moved = timing.skew_free(3 / 30, 3 / 30 + 0.022, 24.0, 143.0)  # 30 px/s: corrected
+    assert moved == pytest.approx(24.0 + 30 * 0.022)
