@@ -42,6 +42,8 @@ class EstimatorConfig:
     sigmas: float = 5.0  # a sighting's own noise allowed, in standard deviations
     size_tolerance: float = 0.3  # the disc's radius against its disparity, relative
     outlier_stop_s: float = 2.0
+    min_depth_m: float = 0.2  # a sighting nearer than this or farther than max_depth_m (or at
+    max_depth_m: float = 8.0  # a disparity <= 0) is not the robot, even as the first one
     alpha: float = 0.5  # the filter's position and rate gains per accepted sighting
     beta: float = 0.05
     spin_share: float = 0.15  # of a spin's duty that unequal wheels may turn into travel
@@ -142,6 +144,9 @@ class Estimator:
 
     def gate(self, s: Sighting) -> str:
         """Why the sighting cannot be the robot ("" if it can)."""
+        if not (s.disparity > 0 and self.cfg.min_depth_m <= self.g.depth_m(s.disparity)
+                <= self.cfg.max_depth_m):  # a skew correction across a jump makes anything
+            return f"its disparity ({s.disparity:.1f} px) is no depth a robot can be at"
         z, x = self.position(s)
         if self._ratios and len(self._ratios) >= 5:
             ratio = float(np.median(self._ratios))

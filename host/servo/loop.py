@@ -33,6 +33,7 @@ from host.camera.calibration import Geometry
 from host.camera.source import CameraError, StereoFrame, StereoSource
 from host.servo.acquire import NOT_MOVED, AcquireConfig, Acquisition
 from host.servo.controller import Command, ControlConfig, Controller, Observation
+from host.servo.deflicker import deflickered
 from host.servo.estimator import AGAINST, OUTSIDE, STILL, Estimator, EstimatorConfig, Sighting
 from host.servo.inputs import FrozenSensors, camera_moved, views_agree
 from host.servo.marker import MarkerPair, block_disparity, marker_candidates
@@ -287,7 +288,22 @@ class Servo:
     def _see(self, frame: StereoFrame) -> _Seen:
         """The marker: the best candidate the estimator's gate admits and block matching over
         it confirms. Candidates near the last sighting first; all of them refused, the whole
-        image is searched (the robot may be elsewhere, and a look-alike near)."""
+        image is searched (the robot may be elsewhere, and a look-alike near). The rows lit
+        unevenly (mains flicker on rolling shutters): searched on the pair with each row's
+        light factor taken out (deflicker.py), through the same checks, and on the pair as it
+        came only if none is admitted there."""
+        flat = None
+        if self._reference_image is not None:
+            flat = deflickered(frame, self._reference_image)
+        seen = self._search(flat) if flat is not None else _Seen()
+        if seen.pair is None:
+            again = self._search(frame)
+            if again.pair is not None or not seen.rejected:
+                seen = again
+        return seen
+
+    def _search(self, frame: StereoFrame) -> _Seen:
+        """_see's search on one version of the pair."""
         seen = _Seen()
         cfg, g = self.cfg, self.geometry
         for whole in (False, True):

@@ -13,6 +13,7 @@ class TimingConfig:
     stale_s: float = 0.3  # a capture this long after the previous one, or this much later than
     # frames usually arrive, is stale
     max_skew_s: float = 0.045  # a pair whose two captures differ by more is not used
+    max_shift: float = 0.2  # of the disparity: the largest skew correction
 
 
 class FrameTiming:
@@ -47,6 +48,11 @@ class FrameTiming:
         prev = self._prev
         if prev is not None and skew and t_right > prev[0] \
                 and t_right - prev[0] < 3 * self.cfg.stale_s:
-            d += (right_u - prev[1]) / (t_right - prev[0]) * skew
+            shift = (right_u - prev[1]) / (t_right - prev[0]) * skew
+            # more than a fifth of the disparity is no motion of the robot's (it moves
+            # mostly in depth, its image slowly): the last sighting was another marker (a
+            # look-alike left out, a re-acquisition), and the pair is left as it came
+            if abs(shift) <= self.cfg.max_shift * abs(d):
+                d += shift
         self._prev = (t_right, right_u)
         return d

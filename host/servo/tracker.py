@@ -2,9 +2,11 @@
 with the floor and the robot left out) follows it when it moves (median of the last three),
 retargets onto a nearer object only once NearerObject vouches for it (three re-measures running
 at the same place and depth, its two views agreeing: a flicker phantom moves and does not
-match), and ends the run ("target vanished") when most of its area twice shows what lay behind
-it and its two views no longer agree at its disparity (a map spoilt by flicker is not a box
-gone; a pure state machine)."""
+match). When most of its area twice shows what lay behind it and its two views no longer agree
+at its disparity (a map spoilt by flicker is not a box gone) the target is gone: the next
+nearest object becomes the target once two running re-measures find it at the same place and
+depth, its two views agreeing (the wall behind is no object); none within three more
+re-measures, the run ends ("target vanished"; a pure state machine)."""
 
 from __future__ import annotations
 
@@ -26,6 +28,10 @@ class TrackerConfig:
     agree: int = 2  # re-measures that must agree before a "vanished"
     overlap: float = 0.3  # of the narrower region's width: the same object
     still_there: float = 0.6  # views agreeing this well at the object's disparity: not gone
+    successor: int = 2  # re-measures that must find the same next object once it is gone
+    successor_tries: int = 3  # re-measures after "gone" without one: the run ends
+    object_width: float = 0.6  # of the image's width: wider is the wall behind, no object
+    same_depth: float = 0.35  # of its disparity: a target moved farther is another object
 
 
 class TargetTracker:
@@ -37,6 +43,8 @@ class TargetTracker:
         self.retargeted = False  # the last update moved the target to a new object
         self._doubt = (0, "")  # consecutive re-measures that disagree, and how
         self.nearer = NearerObject()
+        self.successor = NearerObject(frames=config.successor)  # the next object, once gone
+        self.gone = 0  # re-measures since the target was found gone (0: it is not)
 
     def update(self, disp: np.ndarray, agreement: Callable[[Target], float] = lambda t: 1.0
                ) -> Target:
@@ -55,13 +63,20 @@ class TargetTracker:
             found = None
         overlap = found is not None and min(bx + bw, found.bbox[0] + found.bbox[2]) - max(
             bx, found.bbox[0]) > self.cfg.overlap * min(bw, found.bbox[2])
+        if overlap and found is not None and (
+                found.bbox[2] > self.cfg.object_width * disp.shape[1]
+                or abs(found.disparity - old.disparity) > self.cfg.same_depth * old.disparity):
+            overlap = False  # the wall behind it, or another object: not the target moved
         nearer = found is not None and not overlap and found.disparity > old.disparity
         vouched = self.nearer.update(found if nearer else None,
                                      agreement(found) if nearer and found else float("nan"))
+        if self.gone:
+            return self._succeed(self._vouch(found, agreement, disp.shape[1]))
         if found is not None and overlap:
             if not agreement(found) >= self.cfg.still_there:
                 return old  # its two views disagree there: a spoilt map (flicker), not it
             self._doubt = (0, "")
+            self.successor.reset()
             self.history.append(found.disparity)
             del self.history[:-self.cfg.history]
             median = float(np.median(self.history))
@@ -73,8 +88,11 @@ class TargetTracker:
         if behind >= old.area // 2 and not agreement(old) >= self.cfg.still_there:
             n = self._doubt[0] + 1 if self._doubt[1] == "vanished" else 1
             self._doubt = (n, "vanished")
+            # the next object is looked for from the first doubt on
+            vouched = self._vouch(found if not overlap else None, agreement, disp.shape[1])
             if n >= self.cfg.agree:
-                self.stop_reason = VANISHED
+                self.gone = 1
+                return self._succeed(vouched)
             return old
         if vouched is None:
             return old  # hidden, a nearer object not yet vouched for, or nothing clear
@@ -85,3 +103,28 @@ class TargetTracker:
         self.history = [found.disparity] * (self.cfg.history - 1)
         self.retargeted = True
         return found
+
+    def _vouch(self, found: Target | None, agreement: Callable[[Target], float],
+               width: int) -> Target | None:
+        """Feed the successor's consistency check: an object (not the wall behind: narrower
+        than object_width of the image) that agrees in both views."""
+        if found is not None and found.bbox[2] > self.cfg.object_width * width:
+            found = None
+        return self.successor.update(found, agreement(found) if found else float("nan"))
+
+    def _succeed(self, vouched: Target | None) -> Target:
+        """The target is gone: the next nearest object (vouched: as _vouch returned it)
+        becomes it; none after successor_tries more re-measures: the run ends (VANISHED)."""
+        if vouched is None:
+            self.gone += 1
+            if self.gone > self.cfg.successor_tries:
+                self.stop_reason = VANISHED
+            return self.target
+        self.gone = 0
+        self._doubt = (0, "")
+        self.nearer.reset()
+        self.successor.reset()
+        self.target = vouched
+        self.history = [vouched.disparity] * (self.cfg.history - 1)
+        self.retargeted = True
+        return vouched

@@ -75,3 +75,29 @@ def test_the_depth_must_move_the_way_the_robot_is_driven(facing_away: bool, dz: 
         est.accept(sighting(t + 1 / 30, z))
         got = got or est.motion(t + 1 / 30, 500, 500, facing_away, True)
     assert got == want
+
+
+@pytest.mark.parametrize("disparity", [-16.0, 0.0, 2.0, 200.0])
+def test_a_first_sighting_at_no_depth_a_robot_can_be_at_is_refused(disparity: float) -> None:
+    """With no state yet (a re-acquisition after a look-alike was left out), a skew correction
+    across the jump from the look-alike to the robot made a disparity of -16 px: taken as the
+    first sighting, it made every true one 3.4 m "from where the robot can be" (seed 4, trial
+    34: the run stopped with that reason while the robot stood in view at 2.8 m)."""
+    est = Estimator(G)
+    assert "no depth a robot can be at" in est.gate(Sighting(0.0, disparity, G.cx, 10.0))
+    assert est.gate(sighting(0.0, 2.8)) == ""
+
+
+def test_the_skew_correction_does_not_follow_a_jump_to_another_marker() -> None:
+    """The skew correction moves the right centre back by its image speed times the skew; from
+    a look-alike at u = 247 to the robot 90 px away in a frame, that 'speed' made -16 px of a
+    24 px disparity (seed 4, trial 34). A robot's own motion moves its image slowly: a small
+    correction is still made, one beyond a fifth of the disparity is not."""
+    from host.servo.timing import FrameTiming
+
+    timing = FrameTiming()
+    timing.skew_free(0.0, 0.022, 15.0, 232.0)  # the look-alike
+    assert timing.skew_free(1 / 30, 1 / 30 + 0.022, 24.0, 142.0) == 24.0
+    timing.skew_free(2 / 30, 2 / 30 + 0.022, 24.0, 142.0)
+    moved = timing.skew_free(3 / 30, 3 / 30 + 0.022, 24.0, 143.0)  # 30 px/s: corrected
+    assert moved == pytest.approx(24.0 + 30 * 0.022)

@@ -22,8 +22,10 @@ from host.servo.perception import (
 from host.sim.faults import Event, WorldFaults
 from host.sim.renderer import Renderer
 from host.sim.run import Setup, simulation
-from host.sim.world import World
+from host.sim.world import Box, World
 from host.stereo import MatcherParams, compute_disparity
+
+ALONE = (Box(1.2, -0.50, -0.18, 0.38),)  # the target box and nothing else: no next object
 
 
 def _pair(size=(320, 240), z=1.6, seed=5):
@@ -105,8 +107,8 @@ def test_moved_target_is_followed_when_its_map_takes_several_frames(monkeypatch)
 def test_vanished_target_stops_the_run_when_its_map_takes_several_frames(monkeypatch) -> None:
     monkeypatch.setattr(perception, "STRIP_WORK", 1_000_000)
     faults = WorldFaults(events=(Event(1.0, "vanish", 0),))
-    with simulation(Setup((320, 240), 0.8, faults=faults)) as sim:
-        sim.run(6.0)
+    with simulation(Setup((320, 240), 0.8, faults=faults, boxes=ALONE)) as sim:
+        sim.run(9.0)  # two re-measures to find it gone, three to find no next object
         assert sim.servo.stop_reason == "target vanished"
 
 

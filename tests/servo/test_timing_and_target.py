@@ -10,6 +10,9 @@ import pytest
 from host.camera.source import StereoFrame
 from host.sim.faults import Event, WorldFaults
 from host.sim.run import Setup, simulation
+from host.sim.world import Box
+
+ALONE = (Box(1.2, -0.50, -0.18, 0.38),)  # the target box and nothing else: no next object
 
 
 def test_target_moved_mid_run_is_followed() -> None:
@@ -24,10 +27,27 @@ def test_target_moved_mid_run_is_followed() -> None:
         assert abs(sim.world.robot.z_m - 1.0) <= 0.02
 
 
-def test_target_that_vanishes_stops_the_run_with_its_reason() -> None:
+def test_when_the_target_is_taken_away_the_next_nearest_object_becomes_it() -> None:
+    """The box at 1.2 m is taken away while the robot drives from 0.8 m: the box at 1.8 m
+    (found in two running re-measures, its views agreeing) becomes the target, its keep-out
+    from its own extent, and the robot holds at it (on the tracker before: "target
+    vanished")."""
     faults = WorldFaults(events=(Event(1.0, "vanish", 0),))
     with simulation(Setup((320, 240), 0.8, faults=faults)) as sim:
-        sim.run(6.0)
+        sim.run(6.0, settle=None)
+        assert sim.servo.target_m == pytest.approx(1.8, abs=0.03)
+        assert any("retargeting" in n for n in sim.servo.notes)
+        x0, x1 = sim.servo.controller.keep_out
+        assert x0 == pytest.approx(0.22, abs=0.03) and x1 == pytest.approx(0.55, abs=0.05)
+        sim.run(30.0)
+        assert sim.servo.outcome() == ("held", "")
+        assert abs(sim.depth_error_m()) <= 0.02
+
+
+def test_target_that_vanishes_stops_the_run_with_its_reason() -> None:
+    faults = WorldFaults(events=(Event(1.0, "vanish", 0),))
+    with simulation(Setup((320, 240), 0.8, faults=faults, boxes=ALONE)) as sim:
+        sim.run(9.0)  # two re-measures to find it gone, three to find no next object
         assert sim.servo.stop_reason == "target vanished"
         assert sim.servo.outcome() == ("stopped", "target vanished")
         assert sim.emulator.motors() == (0, 0)

@@ -142,11 +142,9 @@ SCENARIOS = {
         (Event(1.0, "knock", angle_deg=-2.0),)),
     # mains flicker on rolling shutters 5 or 15 ms apart
     "flicker, sensors 5 ms apart": case(
-        (Event(1.0, "flicker", fraction=0.2, gap_ms=5.0),), "a nearer object must persist and "
-        "agree in both views before a retarget (inputs.NearerObject, views_agree)"),
+        (Event(1.0, "flicker", fraction=0.2, gap_ms=5.0),)),
     "flicker, sensors 15 ms apart": case(
-        (Event(1.0, "flicker", fraction=0.2, gap_ms=15.0),), "a nearer object must persist "
-        "and agree in both views before a retarget (inputs.NearerObject, views_agree)"),
+        (Event(1.0, "flicker", fraction=0.2, gap_ms=15.0),)),
     # the card half behind the target's edge: never seen
     "the marker half hidden behind the object": case(
         (Event(0.0, "behind", 0, z_m=1.6, fraction=0.5),), start_z=1.6),

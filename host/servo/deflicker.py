@@ -1,0 +1,59 @@
+"""Mains flicker read by rolling shutters taken out of a stereo pair: each row's light factor.
+
+A rolling shutter reads its rows one after the other, so light varying at 100 Hz multiplies
+each row by its own factor (a band pattern, 80 rows a period at 320x240 with a 30 ms readout),
+and the two sensors, a few ms apart, see different bands. The marker's ring is then no longer
+uniform and its disc no longer darker than its neighbourhood on every row: it is missed two
+frames in three. The factor of each row of the left view is the median over the row of its
+ratio to the reference image (the scene without the robot: the robot covers a few columns of a
+row, the median ignores them); the right view's is the left's times the ratio of the two rows'
+medians (both views see the same row of the scene). A pure function on arrays; the servo uses
+it only to search again for a marker it missed, and whatever it finds goes through the same
+gate, size and block-matching checks as any sighting.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from host.camera.source import StereoFrame
+from host.stereo.grey import to_grey
+
+MIN_SPREAD = 0.05  # rows' factors spread less than this (5th to 95th percentile): no flicker
+
+
+def row_gains(grey: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """Each row's light factor (float32, height) of grey against reference (same size, the
+    reference phase's left image, float32), smoothed over 5 rows."""
+    step = max(1, grey.shape[1] // 80)  # 80 columns or so: the median of a row is robust
+    ratio = grey[:, ::step].astype(np.float32) / np.maximum(reference[:, ::step], 8.0)
+    gains = np.median(ratio, axis=1).astype(np.float32)
+    return cv2.medianBlur(gains.reshape(-1, 1), 5).ravel()
+
+
+def _scaled(image: np.ndarray, gains: np.ndarray) -> np.ndarray:
+    inv = (1.0 / np.maximum(gains, 0.2)).astype(np.float32)
+    shape = (-1, 1, 1) if image.ndim == 3 else (-1, 1)
+    return np.clip(image.astype(np.float32) * inv.reshape(shape), 0, 255).astype(np.uint8)
+
+
+def deflickered(frame: StereoFrame, reference: np.ndarray,
+                min_spread: float = MIN_SPREAD) -> StereoFrame | None:
+    """The pair with each row of each view divided by its light factor, or None when the rows'
+    factors do not vary (no flicker: nothing to take out). reference: the left image of the
+    reference phase (grey, float32, host.servo.rig.reference_image)."""
+    left, right = to_grey(frame.left), to_grey(frame.right)
+    if left.shape != reference.shape:
+        return None
+    g_left = row_gains(left, reference)
+    lo, hi = np.percentile(g_left, [5, 95])
+    if not hi - lo >= min_spread:
+        return None
+    with np.errstate(invalid="ignore", divide="ignore"):
+        step = max(1, left.shape[1] // 80)
+        rows = np.median(right[:, ::step], axis=1) / np.maximum(
+            np.median(left[:, ::step], axis=1), 1.0)
+    g_right = g_left * cv2.medianBlur(rows.astype(np.float32).reshape(-1, 1), 5).ravel()
+    return StereoFrame(_scaled(frame.left, g_left), _scaled(frame.right, g_right),
+                       frame.t_left, frame.t_right)
