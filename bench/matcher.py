@@ -2,7 +2,9 @@
 
 `python bench/matcher.py --help` lists the sections. Each pair of matchers runs in blocks of
 back-to-back calls, the blocks alternating (own, OpenCV, own, ...) in one process, on the same
-grey input (the Motorcycle pair resized) with the same window and disparity range; a time is
+input (the Motorcycle pair resized: grey for SAD / StereoBM; colour for own SGM at `--matcher
+sgm`'s defaults, which match on colour, and SGBM 3WAY, which converts it to grey) with the same
+disparity range; a time is
 the median over blocks of the mean call time in a block, and the figure that matters is the
 ratio own / OpenCV: as process CPU time on one thread (what the call costs a core, which other
 work on the shared machine moves little) and as wall time on two threads. The load average

@@ -159,8 +159,9 @@ def test_cost_row_by_row_in_the_aggregation_equals_the_cost_volume(config) -> No
 def test_integer_term_equals_the_volume_table_at_every_difference(ch, weight, cap) -> None:
     term = integer_term(ch, weight, cap, 23)
     table = term_table(ch, weight, cap)
-    if term is None:  # the matcher then builds the volume; say which cases do
-        pytest.skip(f"no integer form for weight {weight}, cap {cap}, {ch} channels")
+    if term is None:  # the matcher then builds the volume: only this case here lacks a form
+        assert (ch, weight) == (3, 0.3) and cap >= 20, (ch, weight, cap)
+        return
     k = np.minimum(np.arange(256 * ch), term[1])
     np.testing.assert_array_equal((k * term[2] + term[3]) >> term[4], table)
     assert term[5] >= sgm.CENSUS_BITS + table.max()
