@@ -2,7 +2,9 @@
 
 `python bench/matcher.py --help` lists the sections. Each pair of matchers runs in blocks of
 back-to-back calls, the blocks alternating (own, OpenCV, own, ...) in one process, on the same
-grey input (the Motorcycle pair resized) with the same window and disparity range; a time is
+input (the Motorcycle pair resized: grey for SAD / StereoBM; colour for own SGM at `--matcher
+sgm`'s defaults, which match on colour, and SGBM 3WAY, which converts it to grey) with the same
+disparity range; a time is
 the median over blocks of the mean call time in a block, and the figure that matters is the
 ratio own / OpenCV: as process CPU time on one thread (what the call costs a core, which other
 work on the shared machine moves little) and as wall time on two threads. The load average
@@ -82,24 +84,23 @@ def opencv_range(nd: int) -> int:
     return -(-nd // 16) * 16
 
 
-def resized_pair(w: int, h: int) -> tuple[np.ndarray, np.ndarray]:
+def resized_pair(w: int, h: int, colour: bool = False) -> tuple[np.ndarray, np.ndarray]:
     moto = default_scene()
-    return tuple(to_grey(cv2.resize(v, (w, h), interpolation=cv2.INTER_AREA))
-                 for v in (moto.left, moto.right))
+    views = (cv2.resize(v, (w, h), interpolation=cv2.INTER_AREA) for v in (moto.left, moto.right))
+    return tuple(v if colour else to_grey(v) for v in views)
 
 
 SGBM_3WAY = MatcherParams(matcher="opencv-sgbm", mode="sgbm3way", block_size=3,
                           uniqueness_ratio=10, speckle_window_size=100, speckle_range=2,
                           lr_check=1.0, fill=True, num_disparities=64)
-OWN_SGM = MatcherParams(matcher="sgm", block_size=1, lr_check=1.0, fill=True, border="clip",
-                        num_disparities=64)  # default paths (5)
+OWN_SGM = MatcherParams.for_matcher("sgm").replace(num_disparities=64)  # `--matcher sgm`
 BEST_LOCAL = MatcherParams(matcher="ncc", block_size=5, border="clip", lr_check=1.0, fill=True,
                            median=5, num_disparities=64)
-SGM_PATHS = (5, 8, 4)  # the default first
+SGM_PATHS = (OWN_SGM.paths, *(n for n in (4, 5, 8) if n != OWN_SGM.paths))  # default first
 SAD_WINDOW = 9
 
 
-def pair_params(kind: str, nd: int, paths: int = 5) -> tuple[MatcherParams, object]:
+def pair_params(kind: str, nd: int, paths: int = OWN_SGM.paths) -> tuple[MatcherParams, object]:
     """(own params, OpenCV callable maker) for 'sad' or 'sgm' at nd candidates."""
     if kind == "sad":
         own = MatcherParams(matcher="sad", block_size=SAD_WINDOW, num_disparities=nd,
@@ -111,14 +112,16 @@ def pair_params(kind: str, nd: int, paths: int = 5) -> tuple[MatcherParams, obje
     return own, lambda gl, gr: (lambda: compute_disparity(gl, gr, ref))
 
 
-def speed(kind: str, paths: tuple[int, ...] = (5,)) -> None:
+def speed(kind: str, paths: tuple[int, ...] = (OWN_SGM.paths,)) -> None:
     """Rows of own / OpenCV at every size: CPU time on one thread, wall time on two."""
     other = "StereoBM" if kind == "sad" else "SGBM 3WAY"
     what = (f"own SAD (window {SAD_WINDOW}, default sub-pixel) / cv2.StereoBM" if kind == "sad"
-            else "own SGM (window 1, clip, LR 1 + fill) / cv2 SGBM 3WAY (block 3, LR 1 + fill)")
-    print(f"\n## {what}, grey; CPU ms on 1 thread, wall ms on 2 threads")
+            else "own SGM at `--matcher sgm`'s defaults / cv2 SGBM 3WAY (block 3, grey, LR 1 + "
+                 "fill)")
+    what += ", grey" if kind == "sad" else ", colour pair (each matcher takes what it uses)"
+    print(f"\n## {what}; CPU ms on 1 thread, wall ms on 2 threads")
     for w, h, nd in SIZES:
-        gl, gr = resized_pair(w, h)
+        gl, gr = resized_pair(w, h, colour=kind == "sgm")
         for pth in paths:
             own, maker = pair_params(kind, nd, pth)
             warm_up(own)
@@ -149,9 +152,9 @@ numba.set_num_threads(1)
 cv2.setNumThreads(1)
 w, h, p = int(sys.argv[1]), int(sys.argv[2]), MatcherParams(**json.loads(sys.argv[3]))
 rng = np.random.default_rng(0)
-small = rng.integers(0, 256, (48, 32 + p.num_disparities), dtype=np.uint8)
+small = rng.integers(0, 256, (48, 32 + p.num_disparities, 3), dtype=np.uint8)
 compute_disparity(small, small, p.replace(num_disparities=16))  # load the kernels
-wide = rng.integers(0, 256, (h, w + 32), dtype=np.uint8)
+wide = rng.integers(0, 256, (h, w + 32, 3), dtype=np.uint8)  # colour: the SGM default uses it
 left, right = np.ascontiguousarray(wide[:, 32:]), np.ascontiguousarray(wide[:, :w])
 print("go", flush=True)
 sys.stdin.readline()
@@ -175,10 +178,7 @@ def _anon_bytes(pid: int) -> int:
 def peak_bytes_per_pixel(p: MatcherParams, w: int, h: int, calls: int = 3) -> float:
     """Peak anonymous memory a call adds, in bytes per pixel: a fresh process (one thread)
     runs the matcher `calls` times while this one samples its RssAnon every 0.2 ms."""
-    fields = {k: getattr(p, k) for k in ("matcher", "mode", "block_size", "num_disparities",
-                                         "lr_check", "fill", "border", "colour", "paths",
-                                         "uniqueness_ratio", "speckle_window_size",
-                                         "speckle_range")}
+    fields = p.to_dict()
     child = subprocess.Popen([sys.executable, "-c", PEAK, str(w), str(h), json.dumps(fields),
                               str(calls)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                              text=True)
@@ -201,8 +201,8 @@ def peak_bytes_per_pixel(p: MatcherParams, w: int, h: int, calls: int = 3) -> fl
 
 
 def memory() -> None:
-    print("\n## peak anonymous memory a call adds (one thread, fresh process, random pair, "
-          "sampled every 0.2 ms), B / pixel")
+    print("\n## peak anonymous memory a call adds (one thread, fresh process, random colour "
+          "pair, sampled every 0.2 ms), B / pixel; own SGM at its defaults")
     for w, h, nd in MEMORY_SIZES:
         own = peak_bytes_per_pixel(OWN_SGM.replace(num_disparities=nd), w, h)
         ref = peak_bytes_per_pixel(SGBM_3WAY.replace(num_disparities=nd, colour=False), w, h)
@@ -214,7 +214,7 @@ def memory() -> None:
 
 def quality(mb: Path) -> None:
     print("\n## quality, bad % at 1 px (density %), nonocc / all / disc")
-    rows = [(f"own SGM {paths} paths + LR 1 + fill", OWN_SGM.replace(paths=paths))
+    rows = [(f"own SGM defaults, {paths} paths", OWN_SGM.replace(paths=paths))
             for paths in SGM_PATHS]
     rows += [("SGBM 3WAY colour + LR 1 + fill", SGBM_3WAY),
              ("SGBM 3WAY grey + LR 1 + fill", SGBM_3WAY.replace(colour=False)),
@@ -260,8 +260,8 @@ def subpixel(mb: Path) -> None:
 
 
 SECTIONS = {"sad": "own SAD / StereoBM at every size",
-            "sgm": "own SGM (5 paths) / SGBM 3WAY at every size",
-            "paths": "own SGM with 5, 8 and 4 paths / SGBM 3WAY at every size",
+            "sgm": "own SGM at its defaults / SGBM 3WAY at every size",
+            "paths": "own SGM's defaults with 4, 5 and 8 paths / SGBM 3WAY at every size",
             "memory": "peak memory per pixel of own SGM, SGBM 3WAY and own SAD",
             "quality": "bad % on Cones and Teddy (needs STEREO_SERVO_DATA)",
             "subpixel": "the sub-pixel fits on Cones and Teddy (needs STEREO_SERVO_DATA)"}

@@ -13,7 +13,7 @@ import numpy as np
 from host.errors import HostError
 from host.stereo import block_matching as bm
 from host.stereo import sad, sgm
-from host.stereo.cost import census_ad_volume, match_histogram
+from host.stereo.cost import census_ad_volume, integer_term, match_histogram, reversed_planes
 from host.stereo.grey import to_grey
 from host.stereo.heap import keep_freed_blocks
 from host.stereo.opencv_backend import opencv_disparity
@@ -122,12 +122,14 @@ def sgm_penalties(p: MatcherParams) -> tuple[int, int]:
 
 
 _VOLUMES = threading.local()
-KEEP_BYTES = 128 << 20  # sum volumes up to this size are kept for the next call of the same size
+KEEP_BYTES = 512 << 20  # sum volumes up to this size are kept for the next call of the same size
 
 
 def _sgm_sums(shape: tuple[int, ...], nd: int) -> np.ndarray:
     """The path-sum volume for SGM, reused by the next call on the same size in this thread:
-    a fresh 39 MB costs several ms of page faults per call at 640x480 / 64."""
+    a fresh 39 MB costs several ms of page faults per call at 640x480 / 64, a fresh 315 MB at
+    1280x960 / 128 (the 4-path default) 809 faults and 271 ms of system time (KEEP_BYTES was
+    128 MiB then: 905 ms a call on one thread against 550 with it kept, load 12)."""
     key = (shape[0], shape[1], nd)
     if not key[0]:
         return np.empty(key, dtype=np.uint16)
@@ -139,7 +141,7 @@ def _sgm_sums(shape: tuple[int, ...], nd: int) -> np.ndarray:
     return sums
 
 
-NO_VOLUME = np.empty((0, 0, 0), dtype=np.uint16)
+NO_VOLUME = sgm.NO_VOLUME
 
 
 def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.ndarray:
@@ -151,7 +153,7 @@ def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
     cl, cr = [sgm.census(cv2.copyMakeBorder(g, sgm.CENSUS_H, sgm.CENSUS_H, sgm.CENSUS_W,
                                             sgm.CENSUS_W, cv2.BORDER_REPLICATE))
               for g in (gl, gr)]
-    vol = NO_VOLUME
+    vol, planes, rplanes, term = NO_VOLUME, sgm.NO_PLANES, sgm.NO_PLANES, sgm.census_term()
     if p.intensity_weight > 0 or p.outside_cost != sgm.CENSUS_BITS:
         pl, pr = _planes(left, p.colour), _planes(right, p.colour)
         # the intensity term sees the right image with the left one's levels (per channel),
@@ -159,9 +161,18 @@ def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
         cut = min(p.min_disparity + p.num_disparities, gl.shape[1] // 2)
         pr = np.stack([match_histogram(b, a, b[:, :b.shape[1] - cut], a[:, cut:])
                        for a, b in zip(pl, pr)])
-        vol = np.empty((*gl.shape, p.num_disparities), dtype=np.uint16)
-        vol = census_ad_volume(cl, cr, pl, pr, p.min_disparity, float(p.intensity_weight),
-                               p.intensity_cap, p.outside_cost, vol)
+        weight = float(p.intensity_weight)
+        term = None
+        if p.block_size == 1 and pl.shape[0] in (1, 3):
+            term = integer_term(pl.shape[0], weight, p.intensity_cap, p.outside_cost)
+        if term is not None:
+            # the cost row by row inside the aggregation: no cost volume
+            planes, rplanes = pl, reversed_planes(pr, p.min_disparity, p.num_disparities)
+        else:
+            term = sgm.census_term()
+            vol = np.empty((*gl.shape, p.num_disparities), dtype=np.uint16)
+            vol = census_ad_volume(cl, cr, pl, pr, p.min_disparity, weight, p.intensity_cap,
+                                   p.outside_cost, vol)
     elif p.block_size > 1:
         vol = np.empty((*gl.shape, p.num_disparities), dtype=np.uint16)
         vol = sgm.hamming_volume(cl, cr, p.min_disparity, vol)
@@ -175,8 +186,9 @@ def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
     del cr  # 8 bytes a pixel less at the peak
     disp_l, disp_r = sgm.match(cl, crrev, vol, sums, p.min_disparity,
                                np.uint16(p1), np.uint16(p2), p.paths,
-                               float(p.uniqueness_ratio), subpixel_fit(p), want_right, False)
-    del cl, crrev, vol
+                               float(p.uniqueness_ratio), subpixel_fit(p), want_right, False,
+                               planes, rplanes, term)
+    del cl, crrev, vol, planes, rplanes
     if want_right:
         # the right map has whole pixels: with a sub-pixel left map a tolerance under half a
         # pixel (LR 0, the default) means the same winner, not no sub-pixel result at all

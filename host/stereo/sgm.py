@@ -116,27 +116,56 @@ PAD = np.uint16(0x3FFF)  # path cost beyond the disparity range: never the minim
 
 
 @njit(cache=True, fastmath=True, inline="always")
-def _cost_row(cl, crrev, vol, y, dmin, crow):
+def _cost_row(cl, crrev, vol, pl, prrev, term, y, dmin, crow):
     """Row y of the cost into crow (cols, nd): vol's row when a volume is given (box-summed
-    cost), else the census Hamming distances straight from the census images.
+    cost), else the census Hamming distances straight from the census images, plus (pl has
+    channels) the intensity term, with term[0] where the right pixel is outside the image.
 
     crrev holds each right census row reversed and zero-padded, so candidate j of left x reads
     it forwards from w - 1 - x + dmin: a contiguous load, one vector popcount per 8 lanes (the
-    loop over views vectorises; the same loop over 2-D indices does not).
+    loop over views vectorises; the same loop over 2-D indices does not). prrev holds the right
+    image's planes the same way. The intensity term of a summed |difference| k over the
+    channels is (min(k, term[1]) * term[2] + term[3]) >> term[4] (integer_term: the same as
+    cost.census_ad_volume's table at every k).
     """
     w = cl.shape[1]
     nd = crow.shape[1]
     if vol.shape[0] > 0:
         crow[:, :] = vol[y]
         return
-    far = np.uint16(CENSUS_BITS)
+    far = np.uint16(term[0])
+    ch = pl.shape[0]
+    kcap = np.int32(term[1])
+    ta = np.uint32(term[2])
+    tb = np.uint32(term[3])
+    ts = np.uint32(term[4])
     for x in range(w):
         a = cl[y, x]
         base = w - 1 - x + dmin
         r = crrev[y, base:base + nd]
         c = crow[x]
-        for j in range(nd):
-            c[j] = np.uint16(_popcount(a ^ r[j]))
+        if ch == 0:
+            for j in range(nd):
+                c[j] = np.uint16(_popcount(a ^ r[j]))
+        elif ch == 1:
+            q0 = prrev[0, y, base:base + nd]
+            l0 = np.int32(pl[0, y, x])
+            for j in range(nd):
+                k = min(abs(l0 - np.int32(q0[j])), kcap)
+                c[j] = np.uint16(_popcount(a ^ r[j])) + np.uint16(
+                    (np.uint32(k) * ta + tb) >> ts)
+        else:
+            q0 = prrev[0, y, base:base + nd]
+            q1 = prrev[1, y, base:base + nd]
+            q2 = prrev[2, y, base:base + nd]
+            l0 = np.int32(pl[0, y, x])
+            l1 = np.int32(pl[1, y, x])
+            l2 = np.int32(pl[2, y, x])
+            for j in range(nd):
+                k = min(abs(l0 - np.int32(q0[j])) + abs(l1 - np.int32(q1[j]))
+                        + abs(l2 - np.int32(q2[j])), kcap)
+                c[j] = np.uint16(_popcount(a ^ r[j])) + np.uint16(
+                    (np.uint32(k) * ta + tb) >> ts)
         for j in range(max(0, x - dmin + 1), nd):
             c[j] = far
 
@@ -315,8 +344,9 @@ def _fit_row(fb, out, dmin, fit, n):
 
 
 @njit(cache=True, fastmath=True)
-def _sweep(cl, crrev, vol, S, P, M, crow, tot, forward, i0, i1, p1, p2, diagonals, finish,
-           dmin, uniqueness, fit, want_right, disp_l, disp_r, acc, acc16, sh, keep):
+def _sweep(cl, crrev, vol, pl, prrev, term, S, P, M, crow, tot, forward, i0, i1, p1, p2,
+           diagonals, finish, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc, acc16, sh,
+           keep):
     """Rows i0 .. i1 - 1 (counted from the top when forward, else from the bottom) of one
     direction's paths: path 0 from behind in the row, 2 from the row before at the same x,
     and (diagonals) 1 and 3 from the row before at x - step and x + step.
@@ -336,7 +366,7 @@ def _sweep(cl, crrev, vol, S, P, M, crow, tot, forward, i0, i1, p1, p2, diagonal
     Z = np.zeros(nd + 2, dtype=np.uint16)
     for i in range(i0, i1):
         y = i if forward else h - 1 - i
-        _cost_row(cl, crrev, vol, y, dmin, crow)
+        _cost_row(cl, crrev, vol, pl, prrev, term, y, dmin, crow)
         b = i % 2
         a = 1 - b
         for t in range(w):
@@ -382,8 +412,8 @@ OVERLAP = 24  # rows the lower stripe of the 5-path pass starts above its first 
 
 
 @njit(cache=True, fastmath=True)
-def _down(cl, crrev, vol, S, P, M, crow, tot, y0, y1, warm, p1, p2, dmin, uniqueness, fit,
-          want_right, disp_l, disp_r, acc, acc16, sh, keep):
+def _down(cl, crrev, vol, pl, prrev, term, S, P, M, crow, tot, y0, y1, warm, p1, p2, dmin,
+          uniqueness, fit, want_right, disp_l, disp_r, acc, acc16, sh, keep):
     """The 5-path pass over rows y0 .. y1 - 1, top to bottom: paths 1-3 from the top-left,
     top and top-right and 0 from the left in one sweep along the row (x rising), which leaves
     their sum in tot; then 4 from the right in a sweep back, which adds it and takes each
@@ -408,7 +438,7 @@ def _down(cl, crrev, vol, S, P, M, crow, tot, y0, y1, warm, p1, p2, dmin, unique
     for i in range(y1 - y0 + warm):
         y = y0 - warm + i
         decided = i >= warm
-        _cost_row(cl, crrev, vol, y, dmin, crow)
+        _cost_row(cl, crrev, vol, pl, prrev, term, y, dmin, crow)
         b = i % 2
         a = 1 - b
         m0 = np.uint16(0)
@@ -466,12 +496,14 @@ def _buffers(n, w, nd):
 
 
 @njit(cache=True, parallel=True)
-def match(cl, crrev, vol, S, dmin, p1, p2, paths, uniqueness, fit, want_right, keep):
+def _match(cl, crrev, vol, pl, prrev, term, S, dmin, p1, p2, paths, uniqueness, fit,
+           want_right, keep):
     """Semi-global matching of census images cl and crrev (see _cost_row): disparity maps of
     the left and (want_right) right view in px, NaN where the uniqueness test rejects.
 
-    vol: box-summed cost (rows, cols, nd), or an empty volume to take the Hamming cost from
-    the census rows. S (rows, cols, nd) uint16 holds one direction's path sums: the forward
+    vol: box-summed cost (rows, cols, nd), or an empty volume to take the cost row by row from
+    the census rows and the planes pl, prrev (_cost_row; term[5]: the largest cost).
+    S (rows, cols, nd) uint16 holds one direction's path sums: the forward
     direction (paths from the left and, with 8 paths, top-left, top, top-right; with 4, top)
     sweeps the upper half while the backward one sweeps the lower half from the bottom, each
     storing its sums; then each goes on into the other's half, adds its own paths to the
@@ -490,7 +522,7 @@ def match(cl, crrev, vol, S, dmin, p1, p2, paths, uniqueness, fit, want_right, k
     bits = 0
     while (1 << bits) < nd:
         bits += 1
-    cmax = CENSUS_BITS if vol.shape[0] == 0 else int(vol.max())
+    cmax = int(term[5]) if vol.shape[0] == 0 else int(vol.max())
     sh = bits if bits > 0 and (paths * (cmax + int(p2)) + 1) << bits <= 0xFFFF else 0
     disp_l = np.full((h, w), np.nan, dtype=np.float32)
     disp_r = np.full((h, w), np.nan, dtype=np.float32)
@@ -501,7 +533,7 @@ def match(cl, crrev, vol, S, dmin, p1, p2, paths, uniqueness, fit, want_right, k
             # reuses the first one's memory, so the peak holds one set
             P, M, crow, tot, acc, acc16 = _buffers(1, w, nd)
             y0, y1 = (0, upper) if k == 0 else (upper, h)
-            _down(cl, crrev, vol, S, P[0], M[0], crow[0], tot[0], y0, y1,
+            _down(cl, crrev, vol, pl, prrev, term, S, P[0], M[0], crow[0], tot[0], y0, y1,
                   0 if k == 0 else min(OVERLAP, upper), p1, p2, dmin, uniqueness, fit,
                   want_right, disp_l, disp_r, acc[0], acc16[0], sh, keep)
         return disp_l, disp_r
@@ -514,10 +546,28 @@ def match(cl, crrev, vol, S, dmin, p1, p2, paths, uniqueness, fit, want_right, k
                 i0, i1 = 0, upper if forward else h - upper
             else:
                 i0, i1 = upper if forward else h - upper, h
-            _sweep(cl, crrev, vol, S, P[k], M[k], crow[k], tot[k], forward, i0, i1, p1, p2,
-                   diagonals, phase == 1, dmin, uniqueness, fit, want_right, disp_l, disp_r,
-                   acc[k], acc16[k], sh, keep)
+            _sweep(cl, crrev, vol, pl, prrev, term, S, P[k], M[k], crow[k], tot[k], forward, i0,
+                   i1, p1, p2, diagonals, phase == 1, dmin, uniqueness, fit, want_right, disp_l,
+                   disp_r, acc[k], acc16[k], sh, keep)
     return disp_l, disp_r
+
+
+NO_PLANES = np.zeros((0, 1, 1), dtype=np.uint8)
+NO_VOLUME = np.empty((0, 0, 0), dtype=np.uint16)
+
+
+def census_term(outside: int = CENSUS_BITS) -> np.ndarray:
+    """The term array of _cost_row for census alone: outside beyond the image, no intensity."""
+    return np.array([outside, 0, 0, 0, 0, max(CENSUS_BITS, outside)], dtype=np.int64)
+
+
+def match(cl, crrev, vol, S, dmin, p1, p2, paths, uniqueness, fit, want_right, keep,
+          pl=NO_PLANES, prrev=NO_PLANES, term=None):
+    """_match with the cost from vol, or (vol empty) from the census rows plus, where pl has
+    channels, the intensity term of the planes pl and prrev (cost.reversed_planes) as
+    term says (cost.integer_term; default: census alone, CENSUS_BITS outside the image)."""
+    return _match(cl, crrev, vol, pl, prrev, census_term() if term is None else term, S, dmin,
+                  p1, p2, paths, uniqueness, fit, want_right, keep)
 
 
 def reversed_right(cr: np.ndarray, dmin: int, nd: int) -> np.ndarray:

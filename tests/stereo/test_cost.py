@@ -8,7 +8,13 @@ import numpy as np
 import pytest
 
 from host.stereo import MatcherParams, compute_disparity, sgm
-from host.stereo.cost import census_ad_volume, match_histogram
+from host.stereo.cost import (
+    census_ad_volume,
+    integer_term,
+    match_histogram,
+    reversed_planes,
+    term_table,
+)
 from host.stereo.params import CENSUS_BITS
 from host.stereo.synthetic import synthetic_scene
 
@@ -98,3 +104,71 @@ def test_match_histogram_undoes_a_gain_and_a_gamma() -> None:
         assert np.abs(changed.astype(int) - img).mean() > 10
     # the table comes from the samples given: a sample identical to the reference's is identity
     np.testing.assert_array_equal(match_histogram(img, img), img)
+
+
+def _pair(h: int, w: int, ch: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    # a textured pair shifted by 5..9 px with noise, so the maps have structure to disagree on
+    rng = np.random.default_rng(seed)
+    base = cv2.GaussianBlur(rng.integers(0, 256, (h, w + 12, ch), dtype=np.uint8), (0, 0), 1.0)
+    base = base.reshape(h, w + 12, ch)
+    shift = 5 + (np.arange(w) * 4) // w
+    left = base[:, :w]
+    right = np.stack([base[:, min(x + shift[x], w + 11)] for x in range(w)], axis=1)
+    noise = rng.integers(-3, 4, right.shape)
+    right = np.clip(right.astype(int) + noise, 0, 255).astype(np.uint8)
+    return np.moveaxis(left, 2, 0).copy(), np.moveaxis(right, 2, 0).copy()
+
+
+FUSED = [  # (channels, paths, dmin, nd, weight, cap, outside, uniqueness, fit, p1, p2)
+    (3, 4, 0, 24, 1.0, 20, 23, 30.0, 0, 18, 72),  # the defaults
+    (3, 5, 2, 17, 1.25, 7, 40, 0.0, 1, 18, 72),
+    (1, 8, 0, 33, 0.5, 20, 13, 10.0, 2, 8, 32),
+    (3, 4, 1, 48, 2.0, 255, 62, 0.0, 0, 18, 300),
+    (1, 4, 0, 16, 0.0, 20, 23, 30.0, 0, 8, 32),  # the outside cost alone
+]
+
+
+@pytest.mark.parametrize("config", FUSED)
+def test_cost_row_by_row_in_the_aggregation_equals_the_cost_volume(config) -> None:
+    # the fused path (sgm._cost_row with the planes and integer_term) against the cost volume
+    # census_ad_volume fills, the matcher's previous route: the same maps, the same totals
+    ch, paths, dmin, nd, weight, cap, outside, uniq, fit, p1, p2 = config
+    h, w = 52, 90
+    pl, pr = _pair(h, w, ch, seed=nd)
+    grey_l, grey_r = pl.mean(axis=0).astype(np.uint8), pr.mean(axis=0).astype(np.uint8)
+    cl, cr = _census(grey_l), _census(grey_r)
+    crrev = sgm.reversed_right(cr, dmin, nd)
+    vol = census_ad_volume(cl, cr, pl, pr, dmin, weight, cap, outside,
+                           np.empty((h, w, nd), np.uint16))
+    term = integer_term(ch, weight, cap, outside)
+    assert term is not None
+    args = (dmin, np.uint16(p1), np.uint16(p2), paths, uniq, fit, True, True)
+    tot_vol, tot_rows = (np.empty((h, w, nd), np.uint16) for _ in range(2))
+    want = sgm.match(cl, crrev, vol, tot_vol, *args)
+    got = sgm.match(cl, crrev, sgm.NO_VOLUME, tot_rows, *args, pl,
+                    reversed_planes(pr, dmin, nd), term)
+    for a, b in zip(want, got):
+        np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(tot_vol, tot_rows)
+    assert np.isfinite(want[0]).mean() > 0.4 and len(np.unique(want[0])) > 3
+
+
+@pytest.mark.parametrize("ch", [1, 3])
+@pytest.mark.parametrize("weight", [0.0, 0.3, 0.5, 1.0, 1.25, 2.0, 3.7, 8.0])
+@pytest.mark.parametrize("cap", [0, 7, 20, 100, 255])
+def test_integer_term_equals_the_volume_table_at_every_difference(ch, weight, cap) -> None:
+    term = integer_term(ch, weight, cap, 23)
+    table = term_table(ch, weight, cap)
+    if term is None:  # the matcher then builds the volume: only this case here lacks a form
+        assert (ch, weight) == (3, 0.3) and cap >= 20, (ch, weight, cap)
+        return
+    k = np.minimum(np.arange(256 * ch), term[1])
+    np.testing.assert_array_equal((k * term[2] + term[3]) >> term[4], table)
+    assert term[5] >= sgm.CENSUS_BITS + table.max()
+
+
+def test_matcher_defaults_take_the_cost_row_by_row() -> None:
+    # --matcher sgm's defaults have an integer form: no cost volume is built for them
+    p = MatcherParams.for_matcher("sgm")
+    assert integer_term(3, p.intensity_weight, p.intensity_cap, p.outside_cost) is not None
+    assert integer_term(1, p.intensity_weight, p.intensity_cap, p.outside_cost) is not None
