@@ -82,6 +82,9 @@ SLOW_FILES = {
     "tests/camera/test_calibrate_cli.py": "chessboard calibrations",
     "tests/camera/test_calibration.py": "chessboard calibrations",
     "tests/camera/test_calib_files.py": "a chessboard calibration (the fixture)",
+    "tests/link/test_emulated_serial.py": "faulty emulated lines in real time",
+    "tests/servo/test_loop_rate.py": "simulated servo runs",
+    "tests/test_cli_link.py": "host servo runs on faulty lines",
     "tests/record": "recorded simulated runs",
     "tests/packaging": "builds and installs the package",
 }
