@@ -140,6 +140,16 @@ def test_after_a_link_loss_stop_the_same_drive_is_applied_again(harness, firmwar
     assert driving(last) and last.enable.duty == 0.5
 
 
+
+def test_after_a_link_loss_stop_a_resent_set_config_is_applied(harness, firmware_elf) -> None:
+    """last-command-kept-after-link-loss: the last command before the stop was a SET_CONFIG;
+    sent again after the stop it is applied (ACK APPLIED), not a duplicate."""
+    p = Plan().run(2).msg(0, NO_RAMP).run(2)
+    p.msg(1, gen.SetDrive(left=500, right=500)).run(5).msg(7, NO_RAMP).run(300)
+    p.msg(7, NO_RAMP).run(10)
+    r = run(harness, firmware_elf, p.script)
+    assert acks(r, 7) == [gen.AckResult.APPLIED, gen.AckResult.APPLIED]
+
 # --- reversal ---
 
 
