@@ -125,20 +125,26 @@ _VOLUMES = threading.local()
 KEEP_BYTES = 512 << 20  # sum volumes up to this size are kept for the next call of the same size
 
 
-def _sgm_sums(shape: tuple[int, ...], nd: int) -> np.ndarray:
-    """The path-sum volume for SGM, reused by the next call on the same size in this thread:
-    a fresh 39 MB costs several ms of page faults per call at 640x480 / 64, a fresh 315 MB at
-    1280x960 / 128 (the 4-path default) 809 faults and 271 ms of system time (KEEP_BYTES was
-    128 MiB then: 905 ms a call on one thread against 550 with it kept, load 12)."""
+def _sgm_sums(shape: tuple[int, ...], nd: int, dtype=np.uint16) -> np.ndarray:
+    """The path-sum volume for SGM (uint16) or its kept cost rows (uint8), reused by the next
+    call on the same size in this thread: a fresh 39 MB costs several ms of page faults per
+    call at 640x480 / 64, a fresh 315 MB at 1280x960 / 128 (the 4-path default) 809 faults and
+    271 ms of system time (KEEP_BYTES was 128 MiB then: 905 ms a call on one thread against 550
+    with it kept, load 12)."""
     key = (shape[0], shape[1], nd)
     if not key[0]:
-        return np.empty(key, dtype=np.uint16)
+        return np.empty(key, dtype=dtype)
     kept = getattr(_VOLUMES, "kept", None)
-    if kept is not None and kept[0] == key:
-        return kept[1]
-    sums = np.empty(key, dtype=np.uint16)
-    _VOLUMES.kept = (key, sums) if sums.nbytes <= KEEP_BYTES else None
-    return sums
+    if kept is None:
+        kept = _VOLUMES.kept = {}
+    got = kept.get(np.dtype(dtype).char)
+    if got is not None and got.shape == key:
+        return got
+    kept.pop(np.dtype(dtype).char, None)
+    out = np.empty(key, dtype=dtype)
+    if out.nbytes <= KEEP_BYTES:
+        kept[np.dtype(dtype).char] = out
+    return out
 
 
 NO_VOLUME = sgm.NO_VOLUME
@@ -182,13 +188,17 @@ def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
     want_right = p.lr_check is not None
     # the 5-path pass decides each row as it goes: no sum volume
     sums = _sgm_sums(gl.shape if p.paths != 5 else (0, 0), p.num_disparities)
+    # with 4 or 8 paths each cost row is kept (uint8) for the second direction: made once
+    costs = sgm.NO_COSTS
+    if p.paths != 5 and vol.shape[0] == 0 and term[5] <= 255:
+        costs = _sgm_sums(gl.shape, p.num_disparities, np.uint8)
     crrev = sgm.reversed_right(cr, p.min_disparity, p.num_disparities)
     del cr  # 8 bytes a pixel less at the peak
     disp_l, disp_r = sgm.match(cl, crrev, vol, sums, p.min_disparity,
                                np.uint16(p1), np.uint16(p2), p.paths,
                                float(p.uniqueness_ratio), subpixel_fit(p), want_right, False,
-                               planes, rplanes, term)
-    del cl, crrev, vol, planes, rplanes
+                               planes, rplanes, term, costs)
+    del cl, crrev, vol, planes, rplanes, costs
     if want_right:
         # the right map has whole pixels: with a sub-pixel left map a tolerance under half a
         # pixel (LR 0, the default) means the same winner, not no sub-pixel result at all

@@ -344,7 +344,7 @@ def _fit_row(fb, out, dmin, fit, n):
 
 
 @njit(cache=True, fastmath=True)
-def _sweep(cl, crrev, vol, pl, prrev, term, S, P, M, crow, tot, forward, i0, i1, p1, p2,
+def _sweep(cl, crrev, vol, pl, prrev, term, S, C, P, M, crow, tot, forward, i0, i1, p1, p2,
            diagonals, finish, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc, acc16, sh,
            keep):
     """Rows i0 .. i1 - 1 (counted from the top when forward, else from the bottom) of one
@@ -354,7 +354,9 @@ def _sweep(cl, crrev, vol, pl, prrev, term, S, P, M, crow, tot, forward, i0, i1,
     P (2 row parities, 4 path slots, cols, nd + 2) and M (2, 4, cols) carry the path costs from
     row to row, so one direction can stop at a row and go on from it in a later call. Without
     finish the row's path sum goes into S; with finish it is added to S's row (the other
-    direction's sum) into tot and decided (and, with keep, stored back into S).
+    direction's sum) into tot and decided (and, with keep, stored back into S). C (rows, cols,
+    nd) uint8, when not empty, takes each cost row made without finish, and a row with finish
+    reads its cost from there (the other direction made it), so each row's cost is made once.
     """
     h, w = cl.shape
     nd = S.shape[2]
@@ -364,9 +366,23 @@ def _sweep(cl, crrev, vol, pl, prrev, term, S, P, M, crow, tot, forward, i0, i1,
     fb = np.empty((4, w), dtype=np.float32)
     mins = np.empty(w, dtype=np.uint16)
     Z = np.zeros(nd + 2, dtype=np.uint16)
+    reuse = C.shape[0] > 0
     for i in range(i0, i1):
         y = i if forward else h - 1 - i
-        _cost_row(cl, crrev, vol, pl, prrev, term, y, dmin, crow)
+        if reuse and finish:
+            for x in range(w):
+                cx = C[y, x]
+                r = crow[x]
+                for j in range(nd):
+                    r[j] = np.uint16(cx[j])
+        else:
+            _cost_row(cl, crrev, vol, pl, prrev, term, y, dmin, crow)
+            if reuse:
+                for x in range(w):
+                    cx = C[y, x]
+                    r = crow[x]
+                    for j in range(nd):
+                        cx[j] = np.uint8(r[j])
         b = i % 2
         a = 1 - b
         for t in range(w):
@@ -496,7 +512,7 @@ def _buffers(n, w, nd):
 
 
 @njit(cache=True, parallel=True)
-def _match(cl, crrev, vol, pl, prrev, term, S, dmin, p1, p2, paths, uniqueness, fit,
+def _match(cl, crrev, vol, pl, prrev, term, S, C, dmin, p1, p2, paths, uniqueness, fit,
            want_right, keep):
     """Semi-global matching of census images cl and crrev (see _cost_row): disparity maps of
     the left and (want_right) right view in px, NaN where the uniqueness test rejects.
@@ -546,7 +562,7 @@ def _match(cl, crrev, vol, pl, prrev, term, S, dmin, p1, p2, paths, uniqueness, 
                 i0, i1 = 0, upper if forward else h - upper
             else:
                 i0, i1 = upper if forward else h - upper, h
-            _sweep(cl, crrev, vol, pl, prrev, term, S, P[k], M[k], crow[k], tot[k], forward, i0,
+            _sweep(cl, crrev, vol, pl, prrev, term, S, C, P[k], M[k], crow[k], tot[k], forward, i0,
                    i1, p1, p2, diagonals, phase == 1, dmin, uniqueness, fit, want_right, disp_l,
                    disp_r, acc[k], acc16[k], sh, keep)
     return disp_l, disp_r
@@ -554,6 +570,7 @@ def _match(cl, crrev, vol, pl, prrev, term, S, dmin, p1, p2, paths, uniqueness, 
 
 NO_PLANES = np.zeros((0, 1, 1), dtype=np.uint8)
 NO_VOLUME = np.empty((0, 0, 0), dtype=np.uint16)
+NO_COSTS = np.empty((0, 0, 0), dtype=np.uint8)
 
 
 def census_term(outside: int = CENSUS_BITS) -> np.ndarray:
@@ -562,12 +579,14 @@ def census_term(outside: int = CENSUS_BITS) -> np.ndarray:
 
 
 def match(cl, crrev, vol, S, dmin, p1, p2, paths, uniqueness, fit, want_right, keep,
-          pl=NO_PLANES, prrev=NO_PLANES, term=None):
+          pl=NO_PLANES, prrev=NO_PLANES, term=None, costs=NO_COSTS):
     """_match with the cost from vol, or (vol empty) from the census rows plus, where pl has
     channels, the intensity term of the planes pl and prrev (cost.reversed_planes) as
-    term says (cost.integer_term; default: census alone, CENSUS_BITS outside the image)."""
-    return _match(cl, crrev, vol, pl, prrev, census_term() if term is None else term, S, dmin,
-                  p1, p2, paths, uniqueness, fit, want_right, keep)
+    term says (cost.integer_term; default: census alone, CENSUS_BITS outside the image).
+    costs: with 4 or 8 paths and every cost under 256, a (rows, cols, nd) uint8 buffer in which
+    each cost row is kept for the second direction (see _sweep), else NO_COSTS."""
+    return _match(cl, crrev, vol, pl, prrev, census_term() if term is None else term, S, costs,
+                  dmin, p1, p2, paths, uniqueness, fit, want_right, keep)
 
 
 def reversed_right(cr: np.ndarray, dmin: int, nd: int) -> np.ndarray:

@@ -150,6 +150,13 @@ def test_cost_row_by_row_in_the_aggregation_equals_the_cost_volume(config) -> No
     for a, b in zip(want, got):
         np.testing.assert_array_equal(a, b)
     np.testing.assert_array_equal(tot_vol, tot_rows)
+    if paths != 5 and term[5] <= 255:  # each cost row made once, kept (uint8) for the other
+        # direction
+        kept = sgm.match(cl, crrev, sgm.NO_VOLUME, tot_rows, *args, pl,
+                         reversed_planes(pr, dmin, nd), term, np.empty((h, w, nd), np.uint8))
+        for a, b in zip(want, kept):
+            np.testing.assert_array_equal(a, b)
+        np.testing.assert_array_equal(tot_vol, tot_rows)
     assert np.isfinite(want[0]).mean() > 0.4 and len(np.unique(want[0])) > 3
 
 
