@@ -10,6 +10,7 @@ way the robot faces by what a short probe move does (a pure state machine, one c
              the marker has moved probe_m (and three times its noise, the median of the last
              five sightings against the first five's): the way it faces follows,
              else toward it; nothing moved by probe_s: the run stops with that reason
+             (skipped in a re-acquisition that knows the heading: done after the measure)
 """
 
 from __future__ import annotations
@@ -48,11 +49,15 @@ class Order:
 
 
 class Acquisition:
-    def __init__(self, config: AcquireConfig = AcquireConfig()) -> None:
+    def __init__(self, config: AcquireConfig = AcquireConfig(),
+                 facing_away: bool | None = None) -> None:
+        """facing_away: the heading already known (a re-acquisition where it cannot have
+        changed): no probe move, done after the measure."""
         self.cfg = config
         self.phase = FIND if config.noise_frames > 0 else DONE
         self.disparities: list[float] = []  # the standing robot's, for its noise
-        self.facing_away: bool | None = None  # learnt by the probe (None: not yet)
+        self.facing_away = facing_away  # learnt by the probe (None: not yet)
+        self.probes = facing_away is None
         self.fault = ""  # why the run must end, "" if none
         self._t0: float | None = None  # when the phase began
         self._track: list[tuple[float, float, float]] = []  # (t, z, x) in the probe
@@ -75,7 +80,7 @@ class Acquisition:
             if disparity is not None:
                 self.disparities.append(disparity)
                 if len(self.disparities) >= self.cfg.noise_frames:
-                    self._begin(PROBE, t)
+                    self._begin(PROBE if self.probes else DONE, t)
             return Order(0, 0, MEASURE)
         if self.phase == PROBE:
             return self._probe(t, position, noise_m)

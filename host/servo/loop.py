@@ -31,6 +31,8 @@ import numpy as np
 
 from host.camera.calibration import Geometry
 from host.camera.source import CameraError, StereoFrame, StereoSource
+from host.errors import HostError
+from host.link.client import RobotReset
 from host.servo.acquire import NOT_MOVED, AcquireConfig, Acquisition
 from host.servo.controller import Command, ControlConfig, Controller, Observation
 from host.servo.deflicker import deflickered
@@ -41,16 +43,21 @@ from host.servo.perception import (
     Floor,
     StripMap,
     Target,
+    fit_floor,
     lane_obstacle,
     lane_window,
     match_exposure,
     match_window,
     median_map,
+    nearest_object,
     object_extent,
     reference_target,
     stopping_distance_m,
     without_floor,
 )
+from host.servo.recovery import LANE, MOVED, RESET, RESUME, TARGET, Recovery, no_recovery
+from host.servo.recovery import OUTSIDE as OUTSIDE_KIND
+from host.servo.rereference import refit_floor
 from host.servo.rig import reference_image, vertical_shift_px
 from host.servo.snapshot import Observer, Snapshot, link_stats
 from host.servo.timing import FrameTiming, TimingConfig
@@ -61,6 +68,7 @@ from host.stereo.params import MatcherParams
 AGAINST_REASON = "the depth moves against the commanded direction"
 STILL_REASON = "the marker did not move while the robot drove"
 MAX_FLIPS = 2  # heading corrections in a run before "against" ends it
+REREFERENCE_TRIES = 3  # re-references (of reference_frames each) before a moved camera stops
 
 
 def marker_band(params: MatcherParams, d: float) -> MatcherParams:
@@ -81,7 +89,8 @@ class ServoConfig:
     robot_half_width_m: float = 0.12  # the image region left out of the re-measure
     robot_below_marker_m: float = 0.22
     lane_margin_m: float = 0.05  # watched beyond the stopping distance
-    lane_stop_s: float = 3.0  # an object in the lane this long ends the run
+    lane_stop_s: float = 3.0  # an object in the lane this long ends the run (recover=False)
+    recover: bool = True  # wait out and recover from what passes (host/servo/recovery.py)
     moved_rows: float = 0.005  # of the focal length (0.3 degrees of pitch): the camera moved
     acquire_tries: int = 3  # look-alikes that do not move, left out one after the other
     lane_width_px: int = 320  # the lane is watched on frames scaled down to about this width
@@ -166,10 +175,12 @@ class Servo:
         self._strips: StripMap | None = None  # the re-measure's map, a band per frame
         self._remeasure_t: float | None = None
         self._cmd = Command(0, 0, "wait", None)  # the command in force
-        self._blocked_since: float | None = None  # when the lane ahead was first blocked
-        self._blocked_last = -math.inf  # when it was last
         self._statics: list[tuple[float, float]] = []  # where non-moving look-alikes stand
         self._width = 0
+        self.recovery = Recovery(None if self.cfg.recover else no_recovery(self.cfg.lane_stop_s))
+        self._reref: list[np.ndarray] = []  # the re-reference's maps so far (robot left out)
+        self._reref_fails = 0  # re-references that failed, in this wait
+        self._targets_before: list[Target] = []  # the targets a nearer object replaced
 
     @property
     def stale_s(self) -> float:
@@ -375,14 +386,19 @@ class Servo:
             # object put down over the floor's rows shifts their disparity too
             dy = vertical_shift_px(self._reference_image, frame.left)
             if abs(dy) >= self.cfg.moved_rows * self.geometry.focal_px:
-                self.stop_reason = f"{moved} (the picture moved {dy:+.1f} rows)"
+                self._reref, self._reref_fails = [], 0
+                self._recover(frame.t_left, MOVED, f"{moved} (the picture moved {dy:+.1f} rows)")
                 return
         clean = without_floor(disp, self.floor)
+        before = self.tracker.target
         target = self.tracker.update(clean, lambda t: views_agree(
             frame.left, frame.right, t.bbox, t.disparity))
         if self.tracker.stop_reason:
+            if self._back_to_target(clean, frame):  # a nearer object that came and went
+                return
             self.stop_reason = self.tracker.stop_reason
         if self.tracker.retargeted:
+            self._targets_before.append(before)
             self.notes.append(f"a nearer object appeared at {target.disparity:.2f} px: "
                               f"retargeting")
             self.controller.keep_out = self._extent(object_extent(clean, target))
@@ -390,7 +406,7 @@ class Servo:
 
     # ---------------------------------------------------------------------- the lane
 
-    def _lane_blocked(self, frame: StereoFrame) -> str:
+    def _lane_blocked(self, frame: StereoFrame, cmd: Command | None = None) -> str:
         """An object in the lane ahead of the robot within its stopping distance at its speed
         (and lane_margin_m), the way the control law will move it (toward the target's
         depth), outside the robot's own image region: why the robot must stop, or "". Moving
@@ -400,7 +416,9 @@ class Servo:
             return ""
         z, x = est.state.z, est.state.x
         direction = 1 if z < c.target_m else -1
-        duty = abs(self._cmd.left + self._cmd.right) / 2
+        # the faster of the command in force and the one to be sent (standing, the stretch
+        # the next drive would need)
+        duty = max(abs(c_.left + c_.right) / 2 for c_ in (self._cmd, cmd or self._cmd))
         speed = max(abs(est.state.vz), est.cfg.max_speed_mps * duty / 1000)
         reach = stopping_distance_m(speed) + self.cfg.lane_margin_m
         k = self._lane_scale
@@ -473,7 +491,7 @@ class Servo:
         if acq.done:
             assert self.controller is not None and acq.facing_away is not None
             self.controller.facing_away = acq.facing_away
-            if not acq.facing_away:
+            if not acq.facing_away and acq.probes:
                 self.notes.append("the probe move showed that the robot faces the camera")
         return Command(order.left, order.right, order.phase, None)
 
@@ -524,25 +542,20 @@ class Servo:
                 position = self.estimator.position(sighting)
         elif seen.rejected:
             self.estimator.reject(t, seen.rejected)
-        self._remeasure_band(frame, pair)
-        if self.estimator.outside_too_long(t) and not self.stop_reason:
-            self.stop_reason = f"{OUTSIDE} ({self.estimator.why})"
-        cmd = self._decide(t, pair, position, seen.disparity, invalid)
-        if not cmd.is_stop and cmd.phase in ("drive", "creep", "probe"):
-            blocked = self._lane_blocked(frame)
-            if blocked:  # the controller learns that it stood (its creep floor must not rise)
-                cmd = Command(0, 0, "obstacle", cmd.error_m)
-                assert self.controller is not None
-                self.controller.phase = "obstacle"
-                invalid = invalid or blocked
-                self._blocked_since = self._blocked_since or t
-                self._blocked_last = t
-                if t - self._blocked_since >= self.cfg.lane_stop_s:
-                    self.stop_reason = f"{blocked} for {self.cfg.lane_stop_s:g} s"
-            elif t - self._blocked_last > 1.0:  # clear for a second (standing, the watched
-                self._blocked_since = None  # stretch is shorter: clear now and then)
+        waiting = self._waiting(frame, pair) if self.recovery.kind in (MOVED, RESET) else ""
+        if waiting:  # the robot stands while a recovery is under way (recovery.py)
+            cmd = Command(0, 0, "recover", None)
+            invalid = invalid or waiting
+        else:
+            self._remeasure_band(frame, pair)
+            if self.estimator.outside_too_long(t) and not self.stop_reason and self._recover(
+                    t, OUTSIDE_KIND, f"{OUTSIDE} ({self.estimator.why})"):
+                self.recovery.update(t, True)  # found again through the gate, from scratch
+                self._reacquire(probe=True, why="the marker was seen only outside the gate")
+            cmd = self._decide(t, pair, position, seen.disparity, invalid)
+            cmd, invalid = self._watch_lane(frame, t, cmd, invalid)
         t_send = time.perf_counter()
-        self._send(cmd)
+        self._send(cmd, t)
         rtt_ms = (time.perf_counter() - t_send) * 1000
         self._cmd = cmd
         self.estimator.commanded(t, cmd.left, cmd.right)
@@ -583,11 +596,178 @@ class Servo:
             self.stop_reason = self.controller.fault
         return cmd
 
-    def _send(self, cmd: Command) -> None:
-        if cmd.is_stop:
-            self.link.stop()
+    def _send(self, cmd: Command, t: float = math.nan) -> None:
+        """The command over the link. A reset the link learns of (it has said HELLO again,
+        re-applied its configuration and sent STOP) is waited out, then re-acquired."""
+        try:
+            if cmd.is_stop:
+                self.link.stop()
+            else:
+                self.link.drive(cmd.left, cmd.right)
+        except RobotReset as e:
+            if not self._recover(t, RESET, str(e)):
+                raise
+
+    # ------------------------------------------------------------------- recovery hooks
+
+    def _recover(self, t: float, kind: str, reason: str) -> bool:
+        """Wait out the condition `kind` (recovery.py); False when the run must end instead
+        (stop_reason set)."""
+        was = self.recovery.kind
+        if self.recovery.begin(t, kind, reason):
+            if was != kind:
+                self.notes.append(f"{reason}: the robot waits ({kind})")
+            return True
+        self.stop_reason = self.stop_reason or self.recovery.fault
+        return False
+
+    def _waiting(self, frame: StereoFrame, pair: MarkerPair | None) -> str:
+        """A frame of a wait that takes over the step (moved, reset): the reason the robot
+        stands, or "" when the wait has just ended (the step goes on as usual)."""
+        rec, t = self.recovery, frame.t_left
+        kind = rec.kind
+        # a reset: the link has re-handshaken; STOP answered each frame since
+        clear = self._rereference_frame(frame, pair) if kind == MOVED else True
+        reason = rec.reason
+        verdict = rec.update(t, clear)
+        if verdict == RESUME:
+            self._reacquire(probe=kind == RESET, why=reason)
+            return ""
+        if rec.fault:
+            self.stop_reason = self.stop_reason or rec.fault
+        return f"waiting ({kind}): {reason}"
+
+    def _reacquire(self, probe: bool, why: str) -> None:
+        """Back the safe way: the estimator started afresh from sightings it gates, the
+        acquisition again (with a probe move where the heading may have changed), the
+        controller's state anew but for what it learnt of the object and the wheels."""
+        assert self.controller is not None
+        old = self.controller
+        self.estimator.forget()
+        self.acquisition = Acquisition(self.cfg.acquire,
+                                       facing_away=None if probe else old.facing_away)
+        c = Controller(old.target_m, self.control)
+        c.cfg, c.keep_out, c.trim, c.facing_away = old.cfg, old.keep_out, old.trim, \
+            old.facing_away
+        self.controller = c
+        self._cmd = Command(0, 0, "wait", None)
+        self.notes.append(f"recovered ({why}): re-acquiring the robot")
+
+    def _rereference_frame(self, frame: StereoFrame, pair: MarkerPair | None) -> bool:
+        """A frame of the re-reference after the camera moved: its whole map with the
+        robot's region left out; with reference_frames of them, the floor, reference map and
+        target again (True), or not yet / not possible (False: tried again, REREFERENCE_TRIES
+        times in all)."""
+        disp = compute_disparity(frame.left, frame.right, self.params)
+        robot_at = pair or self.last_pair
+        if robot_at is not None:
+            x0, y0, x1, y1 = self._robot_region(robot_at, frame.left.shape)
+            disp[y0:y1, x0:x1] = np.nan
+        self._reref.append(disp)
+        if len(self._reref) < self.cfg.reference_frames:
+            return False
+        maps, self._reref = self._reref, []
+        why = self._rereference(maps, frame)
+        if why:
+            self._reref_fails += 1
+            if self._reref_fails >= REREFERENCE_TRIES:
+                self.recovery.give_up(f"re-referencing failed: {why}")
+            else:
+                self.notes.append(f"re-referencing failed: {why}; trying again")
+        return not why
+
+    def _rereference(self, maps: list[np.ndarray], frame: StereoFrame) -> str:
+        """The reference again from maps (the robot's region NaN): "" when done, else why
+        not. The floor keeps its slope (rereference.py); the object must be found where it
+        was (the camera moved, not the object) and agree in both views."""
+        assert self.tracker is not None and self.controller is not None
+        old = self.tracker.target
+        reference = median_map(maps)
+        floor = refit_floor(reference, self.floor) if self.floor else fit_floor(reference)
+        if floor is None:
+            return "no floor in the rows the robot leaves free"
+        try:
+            target = nearest_object(without_floor(reference, floor), self.tracker.min_area)
+        except HostError as e:
+            return str(e)
+        if abs(target.disparity - old.disparity) > max(1.0, 0.1 * old.disparity):
+            return (f"the nearest object is at {target.disparity:.1f} px, the target was at "
+                    f"{old.disparity:.1f} px")
+        agree = views_agree(frame.left, frame.right, target.bbox, target.disparity)
+        if not agree >= 0.6:
+            return f"the target's region does not agree in both views ({agree:.2f})"
+        self.floor, self.reference_map = floor, reference
+        self._reference_image = reference_image(frame.left)
+        k = self._lane_scale
+        h, w = reference.shape
+        self._lane_reference = (reference if k == 1 else cv2.resize(
+            reference, (w // k, h // k), interpolation=cv2.INTER_NEAREST) / k)
+        self.tracker = TargetTracker(target, self.tracker.min_area, self.cfg.tracker)
+        self._targets_before.clear()
+        self.controller.target_m = self.geometry.depth_m(target.disparity)
+        self.controller.keep_out = self._extent(
+            object_extent(without_floor(reference, floor), target))
+        assert self._strips is not None
+        self._strips.reset()
+        self._remeasure_t = None
+        self.notes.append(f"re-referenced after the camera moved: target at "
+                          f"{target.disparity:.2f} px")
+        return ""
+
+    def _back_to_target(self, clean: np.ndarray, frame: StereoFrame) -> bool:
+        """The target vanished, and it was a nearer object that had replaced one (a box put
+        down in front of the robot and taken away again): back to the object it replaced
+        when the map finds it where it was, agreeing in both views (True), else False."""
+        assert self.tracker is not None and self.controller is not None
+        if not self._targets_before:
+            return False
+        old = self._targets_before[-1]
+        try:
+            found = nearest_object(clean, self.tracker.min_area, near=old.disparity)
+        except HostError:
+            return False
+        if abs(found.disparity - old.disparity) > max(1.0, 0.1 * old.disparity) or not \
+                views_agree(frame.left, frame.right, found.bbox, found.disparity) >= 0.6:
+            return False
+        reason = f"{self.tracker.stop_reason}: the nearer object went away"
+        if not self._recover(frame.t_left, TARGET, reason):
+            return False
+        self.recovery.update(frame.t_left, True)
+        self._targets_before.pop()
+        self.tracker = TargetTracker(found, self.tracker.min_area, self.cfg.tracker)
+        self.controller.target_m = self.geometry.depth_m(found.disparity)
+        self.controller.keep_out = self._extent(object_extent(clean, found))
+        self.notes.append(f"back to the target it replaced, at {found.disparity:.2f} px")
+        return True
+
+    def _watch_lane(self, frame: StereoFrame, t: float, cmd: Command, invalid: str
+                    ) -> tuple[Command, str]:
+        """The lane ahead, every frame the robot is to move: blocked, it stands (phase
+        "obstacle") and waits (recovery.py's lane bound) until the lane has been clear a
+        while; the controller learns that it stood (its creep floor must not rise)."""
+        assert self.controller is not None
+        moving = not cmd.is_stop and cmd.phase in ("drive", "creep", "probe")
+        blocked = self._lane_blocked(frame, cmd) if moving else ""
+        rec = self.recovery
+        if blocked:
+            if rec.kind == LANE:
+                rec.update(t, False)
+                if rec.fault:
+                    self.stop_reason = self.stop_reason or rec.fault
+            else:
+                self._recover(t, LANE, blocked)
+        elif rec.kind == LANE:
+            if rec.update(t, moving or cmd.phase == "hold") == RESUME:
+                return cmd, invalid
+            if rec.fault:
+                self.stop_reason = self.stop_reason or rec.fault
+            blocked = f"waiting (lane): {rec.reason}"
         else:
-            self.link.drive(cmd.left, cmd.right)
+            return cmd, invalid
+        if not moving:
+            return cmd, invalid or blocked
+        self.controller.phase = "obstacle"
+        return Command(0, 0, "obstacle", cmd.error_m), invalid or blocked
 
     def held_for(self, seconds: float) -> bool:
         """Whether the robot has been holding at the target for the last `seconds`."""

@@ -1,0 +1,128 @@
+"""Waiting out what passes instead of ending the run: a pure state machine, one call a frame.
+
+A recoverable condition (the camera moved, the robot's board reset, an object in the lane, ...)
+begins a wait: the robot stands (the servo sends STOP, the phase says so, the reason is in the
+log) while the condition lasts. When the evidence says it has cleared, and has stayed clear for
+the kind's clear_s, the wait ends and the servo resumes through its safe path (re-reference,
+re-acquire through the estimator's gate). A condition that lasts longer than the kind's
+limit_s, or that comes back more than `times` times in a run, ends the run with its reason, as
+a safe stop: the same reason the servo stopped with before it could recover.
+
+    kind       what clears it                          limit_s  times
+    moved      re-referenced (floor, map, target)        10       2
+    reset      STOP answered for clear_s                 10       3
+    lane       the lane clear for clear_s                20       6
+    stale      fresh frames from both sensors            10       6
+    outside    the marker admitted again (re-acquired)   10       2
+    target     a nearer object that replaced the target went away, the target found
+               again where it was, in both views          -        3
+
+The bounds, on reasoning rather than on any seed: a re-reference takes five frames and its
+checks a few more, so 10 s is many tries; a board that resets comes back within a second
+(handshake, configuration), and one that resets three times in a run is not well; a person
+putting a box down and taking it away again takes a few seconds (the simulated world's boxes
+stay 2-6 s), a box left for 20 s is not coming back soon; a sensor that delivers nothing new
+for 10 s is broken; a marker that keeps leaving the gate after two re-acquisitions is not one
+the servo can trust.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+MOVED, RESET, LANE, STALE, OUTSIDE, TARGET = "moved", "reset", "lane", "stale", "outside", \
+    "target"
+WAIT, RESUME, GIVE_UP = "wait", "resume", "give up"
+
+
+@dataclass(frozen=True)
+class Bound:
+    limit_s: float  # the condition lasting this long ends the run
+    clear_s: float  # cleared by evidence for this long before the servo resumes
+    times: int  # waits of this kind in a run; one more ends it
+
+
+BOUNDS: dict[str, Bound] = {
+    MOVED: Bound(10.0, 0.0, 2),
+    RESET: Bound(10.0, 0.5, 3),
+    LANE: Bound(20.0, 1.0, 6),
+    STALE: Bound(10.0, 0.3, 6),
+    OUTSIDE: Bound(10.0, 0.0, 2),
+    TARGET: Bound(0.0, 0.0, 3),
+}
+
+
+def no_recovery(lane_stop_s: float) -> dict[str, Bound]:
+    """Bounds that recover from nothing (the servo as it was): every condition ends the run
+    at once, an object in the lane after lane_stop_s."""
+    return {**{k: Bound(0.0, 0.0, 0) for k in BOUNDS}, LANE: Bound(lane_stop_s, 1.0, 1 << 30)}
+
+
+class Recovery:
+    """At most one wait at a time (the first condition met); `fault` says why the run ends."""
+
+    def __init__(self, bounds: dict[str, Bound] | None = None) -> None:
+        self.bounds = dict(BOUNDS if bounds is None else bounds)
+        self.kind = ""  # the condition waited out, "" when none
+        self.reason = ""
+        self.fault = ""  # why the run must end, "" if none
+        self.counts: dict[str, int] = {}
+        self.recovered: list[tuple[float, str, str]] = []  # (t, kind, reason) of each resume
+        self._since = math.nan
+        self._clear_since: float | None = None
+
+    @property
+    def active(self) -> bool:
+        return bool(self.kind)
+
+    def begin(self, t: float, kind: str, reason: str) -> bool:
+        """The condition `kind` (reason: in words) is met at t: wait it out (True), or the run
+        must end (False, fault set). A wait of the same kind already on goes on unchanged."""
+        if self.fault:
+            return False
+        if self.kind == kind:
+            self._clear_since = None
+            return True
+        n = self.counts.get(kind, 0) + 1
+        self.counts[kind] = n
+        bound = self.bounds[kind]
+        if n > bound.times:
+            self.fault = reason if bound.times == 0 else (
+                f"{reason} (the {_nth(n)} time in this run)")
+            return False
+        if self.kind:  # another wait is on: it ends in this one (the stricter is kept)
+            self.kind = ""
+        self.kind, self.reason, self._since, self._clear_since = kind, reason, t, None
+        return True
+
+    def update(self, t: float, clear: bool) -> str:
+        """The frame at t, where the evidence says the condition has cleared (clear) or not:
+        WAIT, RESUME (the wait ends: go the safe way back) or GIVE_UP (fault set)."""
+        if self.fault:
+            return GIVE_UP
+        if not self.kind:
+            return RESUME
+        bound = self.bounds[self.kind]
+        if not clear:
+            self._clear_since = None
+            if t - self._since >= bound.limit_s:
+                self.fault = f"{self.reason} for {bound.limit_s:g} s"
+                return GIVE_UP
+            return WAIT
+        if self._clear_since is None:
+            self._clear_since = t
+        if t - self._clear_since >= bound.clear_s:
+            self.recovered.append((t, self.kind, self.reason))
+            self.kind, self.reason, self._clear_since = "", "", None
+            return RESUME
+        return WAIT
+
+    def give_up(self, why: str) -> None:
+        """The recovery itself failed (why): the run ends."""
+        self.fault = f"{self.reason}: {why}" if self.reason else why
+        self.kind = ""
+
+
+def _nth(n: int) -> str:
+    return {1: "first", 2: "second", 3: "third", 4: "fourth", 5: "fifth"}.get(n, f"{n}th")

@@ -1,0 +1,89 @@
+"""The servo waits out what passes and recovers (host/servo/recovery.py), in the simulated world.
+
+Each recoverable event of issue 23 in a short scenario: the run must go on to hold (safely, as
+the trials judge it) and say that it recovered; each bound must end the run in its named stop.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import pytest
+
+from host.emulator.emulator import Faults as LinkFaults
+from host.link import protocol_gen as gen
+from host.servo.recovery import BOUNDS, LANE, MOVED, RESET, TARGET, Bound, Recovery
+from host.servo_run import HELD, Rules, run_servo
+from host.sim.faults import Event, WorldFaults
+from host.sim.run import Setup, simulation
+from host.sim.trials import HOLD_WITHIN_M, Judge
+
+SEED = 3  # never 7 or 8 (held out)
+
+
+@dataclass
+class Run:
+    how: str
+    reason: str
+    error_m: float
+    recovered: list[str]  # the kinds of wait that resumed
+    notes: list[str]
+
+
+def run(events: tuple[Event, ...] = (), link: LinkFaults = LinkFaults(), start_z: float = 1.9,
+        seconds: float = 25.0, bounds: dict[str, Bound] | None = None) -> Run:
+    setup = Setup(start_z_m=start_z, faults=WorldFaults(events=events, link=link), seed=SEED)
+    last = max((e.t_s + e.duration_s for e in events), default=0.0)
+    with simulation(setup) as sim:
+        if bounds is not None:
+            sim.servo.recovery = Recovery(bounds)
+        end = run_servo(sim.servo, Rules(settle_s=1.0, limit_s=seconds, lost_s=5.0,
+                                         hold_from_s=last + 2.5),
+                        sim.source.clock, lambda: sim.world.robot.z_m, watch=Judge(sim))
+        return Run(end.how, end.reason, sim.depth_error_m(),
+                   [k for _, k, _ in sim.servo.recovery.recovered], list(sim.servo.notes))
+
+
+def _held(r: Run, kind: str) -> None:
+    assert r.how == HELD, (r.how, r.reason, r.notes)
+    assert abs(r.error_m) <= HOLD_WITHIN_M
+    assert kind in r.recovered, r.notes
+
+
+BOOT_LOST = LinkFaults(reset_at_ms=3000, reset_cause=int(gen.ResetCause.WATCHDOG),
+                       boot_lost=True)
+
+
+@pytest.mark.parametrize("angle", [1.5, -2.0], ids=["down 1.5 deg", "up 2 deg"])
+def test_a_knocked_camera_is_re_referenced_and_the_robot_holds(angle):
+    r = run((Event(2.0, "knock", angle_deg=angle),))
+    _held(r, MOVED)
+    assert any(n.startswith("re-referenced") for n in r.notes)
+
+
+def test_a_reset_whose_boot_frame_is_lost_is_waited_out_and_the_robot_re_acquired():
+    _held(run(link=BOOT_LOST), RESET)
+
+
+def test_a_box_put_down_in_the_lane_is_waited_out_and_the_target_taken_up_again():
+    r = run((Event(1.0, "lane-box", ahead_m=0.35, width_m=0.3, duration_s=5.0),), start_z=0.6)
+    _held(r, LANE)
+
+
+def test_a_box_left_in_the_lane_ends_the_run_after_the_lane_bound():
+    bounds = {**BOUNDS, LANE: Bound(4.0, 1.0, 6), TARGET: Bound(0.0, 0.0, 0)}
+    r = run((Event(1.0, "lane-box", ahead_m=0.35, width_m=0.3),), start_z=0.6,
+            bounds=bounds)
+    assert r.how == "stopped"
+    assert r.reason.startswith("an object in the lane") and r.reason.endswith("for 4 s"), r
+
+
+def test_a_camera_knocked_more_often_than_the_bound_ends_the_run_with_its_reason():
+    bounds = {**BOUNDS, MOVED: Bound(10.0, 0.0, 1)}
+    r = run((Event(2.0, "knock", angle_deg=1.5), Event(7.0, "knock", angle_deg=1.5)),
+            bounds=bounds)
+    assert r.how == "stopped"
+    assert "the camera moved since the reference" in r.reason
+    assert r.reason.endswith("(the second time in this run)"), r.reason
+    assert not math.isnan(r.error_m)
