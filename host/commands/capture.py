@@ -8,7 +8,7 @@ import time
 from pathlib import Path
 
 from host.camera.manifest import write_manifest
-from host.camera.open import add_camera_options, open_source
+from host.camera.open import add_camera_options, default_geometry, open_source
 from host.commands.options import COUNT, NON_NEGATIVE
 from host.errors import HostError
 from host.files import check_folder, write_image_atomic
@@ -38,12 +38,12 @@ def run(args: argparse.Namespace) -> int:
     check_record(args)
     with open_source(args) as source, recording(args, time.monotonic) as rec:
         if rec is not None:  # every pair the camera delivers, not only those saved
-            from host.camera.calibration import Calibration, Geometry
+            from host.camera.calib_files import Calibration
             from host.camera.open import parse_size
             from host.record.tap import RecordingSource
 
             geometry = (Calibration.load(args.calib).geometry if args.calib
-                        else Geometry.minoru_default(*parse_size(args.size)))
+                        else default_geometry(*parse_size(args.size)))
             source = RecordingSource(source, rec, geometry)
         camera = {**source.describe(), "calib": args.calib}
         pairs: list[dict] = []

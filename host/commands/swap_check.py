@@ -34,7 +34,7 @@ class CheckedSource(StereoSource):
             return frame
         return StereoFrame(frame.right, frame.left, frame.t_right, frame.t_left)
 
-    def describe(self) -> dict:
+    def describe(self) -> dict[str, Any]:
         return self.inner.describe()
 
     def close(self) -> None:

@@ -2,7 +2,9 @@
 
     with RobotLink("/dev/ttyACM0") as robot:   # opens, says HELLO, checks the schema hash
         robot.drive(300, 300)                  # permille duty; resent until acknowledged
-        robot.keepalive()                      # call often: resends the drive every keepalive_s
+        robot.keepalive()                      # for a caller that drives less often than
+                                               # link_timeout_ms / 3 (the servo sends
+                                               # SET_DRIVE every frame)
     # leaving the block sends STOP, also on an exception or Ctrl-C
 
 Every failure is a LinkError with a one-line message. Before driving, every status_s the link

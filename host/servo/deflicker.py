@@ -29,13 +29,15 @@ def row_gains(grey: np.ndarray, reference: np.ndarray) -> np.ndarray:
     step = max(1, grey.shape[1] // 80)  # 80 columns or so: the median of a row is robust
     ratio = grey[:, ::step].astype(np.float32) / np.maximum(reference[:, ::step], 8.0)
     gains = np.median(ratio, axis=1).astype(np.float32)
-    return cv2.medianBlur(gains.reshape(-1, 1), 5).ravel()
+    smooth: np.ndarray = cv2.medianBlur(gains.reshape(-1, 1), 5)
+    return smooth.ravel()
 
 
 def _scaled(image: np.ndarray, gains: np.ndarray) -> np.ndarray:
     inv = (1.0 / np.maximum(gains, 0.2)).astype(np.float32)
     shape = (-1, 1, 1) if image.ndim == 3 else (-1, 1)
-    return np.clip(image.astype(np.float32) * inv.reshape(shape), 0, 255).astype(np.uint8)
+    out: np.ndarray = np.clip(image.astype(np.float32) * inv.reshape(shape), 0, 255)
+    return out.astype(np.uint8)
 
 
 def deflickered(frame: StereoFrame, reference: np.ndarray,

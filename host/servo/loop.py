@@ -235,7 +235,7 @@ class Servo:
                 self._reference_image = reference_image(f.left)
             disps.append(compute_disparity(f.left, f.right, self.params))
             self._notify(f, "reference", "measuring the scene", disps[-1], 0, None, None)
-            self.link.stop()  # keeps the link alive while the robot waits
+            self.link.stop()  # the robot stands while it waits
         h, w = disps[0].shape
         min_area = self.cfg.min_area or (w * h) // 100
         self._strips = StripMap(self.params, (h, w))
