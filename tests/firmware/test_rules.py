@@ -205,6 +205,20 @@ def test_a_command_differing_only_in_its_id_is_applied(harness, firmware_elf) ->
     assert timeline(r.io, "left")[-1].enable.duty == 0.25
 
 
+def test_a_command_differing_only_in_its_id_from_the_drive_in_force_is_applied(
+        harness, firmware_elf) -> None:
+    """duplicate-ignores-id, with the drive armed: a SET_CONFIG with the SEQ and payload bytes
+    of the SET_DRIVE in force is a new command (ACK APPLIED), not a resend of the drive. (The
+    other order no longer tells: a SET_DRIVE after a SET_CONFIG finds no drive armed, and a
+    drive not armed is applied again whatever it matched.)"""
+    config = gen.SetConfig(link_timeout_ms=250, accel_limit=0)
+    drive = gen.SetDrive(left=250, right=0)
+    assert pack(config)[1] == pack(drive)[1]
+    p = Plan().run(2).msg(5, drive).run(3).msg(5, config).run(10)
+    r = run(harness, firmware_elf, p.script)
+    assert acks(r, 5) == [gen.AckResult.APPLIED, gen.AckResult.APPLIED]
+
+
 def test_a_command_differing_only_in_its_last_byte_is_applied(harness, firmware_elf) -> None:
     """duplicate-compares-first-byte."""
     p = Plan().run(2).msg(0, NO_RAMP).run(2)
