@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from host.camera.calibration import Geometry
+from host.camera.geometry import Geometry
 
 AGAINST, STILL = "against", "still"
 OUTSIDE = "the marker is seen only where the robot cannot be"

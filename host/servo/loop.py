@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import cv2
 import numpy as np
 
-from host.camera.calibration import Geometry
+from host.camera.geometry import Geometry
 from host.camera.source import CameraError, StereoFrame, StereoSource
 from host.errors import HostError
 from host.link.client import RobotReset

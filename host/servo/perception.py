@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from host.camera.calibration import Geometry
+from host.camera.geometry import Geometry
 from host.errors import HostError
 from host.stereo.matcher import compute_disparity, numba_threads
 from host.stereo.params import MatcherParams

@@ -8,7 +8,7 @@ import math
 import os
 from dataclasses import asdict, fields
 
-from host.camera.calibration import Geometry
+from host.camera.geometry import Geometry
 from host.files import write_bytes_atomic, write_text_atomic
 from host.servo.loop import LogRow
 

@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from host.camera.calibration import Geometry
+from host.camera.geometry import Geometry
 from host.link import protocol_gen as gen
 from host.servo.marker import MarkerPair
 from host.servo.perception import Target

@@ -7,7 +7,8 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from host.camera.calibration import Calibration, calibrate, find_board
+from host.camera.calib_files import Calibration
+from host.camera.calibration import calibrate, find_board
 from host.camera.source import StereoFrame
 from host.sim.faults import CameraFaults
 from host.sim.renderer import lens_maps

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import contextlib
 import functools
-import math
 import random
 from collections.abc import Iterator
 from dataclasses import dataclass, field
@@ -110,7 +109,3 @@ def _calibration(size: tuple[int, int], distortion: tuple[float, float], seed: i
     seed alone: computed once a process for each (trials share a few cameras)."""
     return calibrate_camera(World.for_size(*size), CameraFaults(distortion=distortion), seed)
 
-
-def truth_target_error_m(run: SimRun) -> float:
-    """How far the servo's target is from the nearest box's true depth (m)."""
-    return run.servo.target_m - run.world.nearest_box().z_m if run.servo.target else math.nan

@@ -5,22 +5,14 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from typing import Protocol
 
 import numpy as np
 
 from host.camera.source import StereoFrame, StereoSource
+from host.emulator.board import Board
 from host.sim.faults import Event
 from host.sim.renderer import Flicker, Renderer
 from host.sim.world import Box, Person, Robot, World
-
-
-class Board(Protocol):
-    """A simulated robot board (native core, simavr ELF, simavr Uno): its clock and motors."""
-
-    def advance(self, ms: float) -> None: ...
-
-    def motors(self) -> tuple[int, int]: ...
 
 
 class SimSource(StereoSource):

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from host.camera.calibration import Geometry
+from host.camera.geometry import Geometry
 from host.sim.faults import MotorFaults
 
 
@@ -35,11 +35,6 @@ class Motors:
     dead_zone: int = 120  # permille
     tau_s: float = 0.08
     wheelbase_m: float = 0.14
-
-    def turn_seconds(self, duty: int) -> float:
-        """How long spinning in place at +duty/-duty takes to turn round (pi): the lag lost
-        at the start comes back as the wheels run down after the stop."""
-        return math.pi * self.wheelbase_m / (2 * self.speed(duty))
 
     def speed(self, duty: float) -> float:
         if abs(duty) <= self.dead_zone:
@@ -76,7 +71,7 @@ class Person:
 
 @dataclass
 class World:
-    geometry: Geometry = field(default_factory=lambda: Geometry(426.0, 0.060, 160.0, 120.0))
+    geometry: Geometry = field(default_factory=lambda: Geometry.minoru_default(320, 240))
     size: tuple[int, int] = (320, 240)
     height_m: float = 0.25  # camera above the floor
     wall_z_m: float = 3.2
@@ -98,8 +93,7 @@ class World:
 
     @classmethod
     def for_size(cls, width: int, height: int, **kw) -> World:
-        s = width / 320.0
-        return cls(Geometry(426.0 * s, 0.060, width / 2, height / 2), (width, height), **kw)
+        return cls(Geometry.minoru_default(width, height), (width, height), **kw)
 
     def nearest_box(self) -> Box:
         return min(self.boxes, key=lambda b: b.z_m)

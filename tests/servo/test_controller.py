@@ -10,9 +10,10 @@ from collections import deque
 import numpy as np
 import pytest
 
+from host.camera.geometry import MINORU_BASELINE_M, MINORU_FOCAL_PX_320
 from host.servo.controller import ControlConfig, Controller, Observation
 
-FB = 25.56  # focal length x baseline of the simulated Minoru at 320x240, px m
+FB = MINORU_FOCAL_PX_320 * MINORU_BASELINE_M  # the simulated Minoru at 320x240, px m
 
 
 class Plant:

@@ -7,10 +7,10 @@ from __future__ import annotations
 
 import pytest
 
-from host.camera.calibration import Geometry
+from host.camera.geometry import Geometry
 from host.servo.estimator import AGAINST, STILL, Estimator, Sighting
 
-G = Geometry(426.0, 0.060, 160.0, 120.0)  # the simulated Minoru at 320x240
+G = Geometry.minoru_default(320, 240)  # the simulated Minoru at 320x240
 FB = G.focal_px * G.baseline_m
 
 

@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from host.camera.calibration import Geometry
+from host.camera.geometry import Geometry
 from host.servo.loop import LogRow
 from host.servo.marker import Blob, MarkerPair
 from host.servo.perception import Target
 from host.servo.snapshot import LinkStats, Snapshot
 
-GEOMETRY = Geometry(426.0, 0.060, 160.0, 120.0)
+GEOMETRY = Geometry.minoru_default(320, 240)
 
 
 def snapshot(t: float = 1.0, robot_px: float = 20.0, phase: str = "drive") -> Snapshot:
