@@ -9,7 +9,7 @@ from host.camera.discovery import SYSFS, discover
 from host.errors import HostError
 
 
-def add_parser(sub: argparse._SubParsersAction) -> None:
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p = sub.add_parser("cameras", help="list stereo cameras and the --camera that opens each")
     p.add_argument("--sysfs", type=Path, default=SYSFS, help="sysfs root to read (default /sys)")
     p.set_defaults(run=run)

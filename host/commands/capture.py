@@ -6,6 +6,7 @@ import argparse
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 from host.camera.manifest import write_manifest
 from host.camera.open import add_camera_options, default_geometry, open_source
@@ -15,7 +16,7 @@ from host.files import check_folder, write_image_atomic
 from host.record import add_record_options, check_record, recording
 
 
-def add_parser(sub: argparse._SubParsersAction) -> None:
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p = sub.add_parser("capture", help="save stereo image pairs from the camera")
     p.add_argument("--count", type=COUNT, default=20, help="pairs to save")
     p.add_argument("--interval", type=NON_NEGATIVE, default=2.0, metavar="S",
@@ -46,7 +47,7 @@ def run(args: argparse.Namespace) -> int:
                         else default_geometry(*parse_size(args.size)))
             source = RecordingSource(source, rec, geometry)
         camera = {**source.describe(), "calib": args.calib}
-        pairs: list[dict] = []
+        pairs: list[dict[str, Any]] = []
         next_t = time.monotonic()
         for frame in source:
             if time.monotonic() < next_t:

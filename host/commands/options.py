@@ -23,9 +23,9 @@ def _bounds(lo: float | None, hi: float | None, lo_open: bool, hi_open: bool) ->
 
 def _ranged(kind: type, lo: float | None, hi: float | None, lo_open: bool,
             hi_open: bool) -> Callable[[str], float]:
-    def parse(text: str):
+    def parse(text: str) -> float:
         try:
-            value = kind(text)
+            value: float = kind(text)
         except ValueError:
             word = "an integer" if kind is int else "a number"
             raise argparse.ArgumentTypeError(f"expected {word}, got {text!r}") from None

@@ -39,7 +39,7 @@ from host.servo_run import ENDED, NOT_SETTLED, Rules, run_servo
 UNO_FLASH = Path("uno-flash.bin")  # --robot uno's flash file when --flash is not given
 
 
-def add_parser(sub: argparse._SubParsersAction) -> None:
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p = sub.add_parser("servo", help="servo the robot to the nearest object's depth")
     p.add_argument("--sim", action="store_true",
                    help="simulated camera and world with the emulator on a pty")

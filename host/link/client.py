@@ -288,7 +288,7 @@ class RobotLink:
         if self.command(gen.SetDrive(left=int(left), right=int(right)), until) is None:
             self.unconfirmed += 1
             self.notes.append(f"SET_DRIVE {left} {right} not confirmed within "
-                              f"{self.drive_budget_s * 1000:.0f} ms: STOP sent instead")
+                              f"{(self.drive_budget_s or 0.0) * 1000:.0f} ms: STOP sent instead")
             self.stop()
             return
         self._last_drive = (int(left), int(right))

@@ -66,7 +66,8 @@ class SerialPort:
 
     def read(self, wait_s: float) -> bytes:
         try:
-            return self._ser.read(max(1, self._ser.in_waiting))  # waits up to its 5 ms timeout
+            data: bytes = self._ser.read(max(1, self._ser.in_waiting))  # waits up to its 5 ms
+            return data  # timeout
         except (serial.SerialException, OSError) as e:
             raise PortError(reason(e)) from None
 

@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -118,7 +119,7 @@ class Controller:
         self.fault = ""  # why the robot must stay stopped (the run ends), "" if none
         self._last_t: float | None = None
         self.history: list[Observation] = []  # valid observations since the last turn
-        self._turn: dict | None = None
+        self._turn: dict[str, Any] | None = None
         self._search_until: float | None = None
 
     # ---------------------------------------------------------------------- estimates

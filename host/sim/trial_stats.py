@@ -40,7 +40,7 @@ def _pct(values: Sequence[float], q: float) -> float:
     return float(np.percentile(values, q)) if len(values) else math.nan
 
 
-def summary(trials: Sequence[Any]) -> dict:
+def summary(trials: Sequence[Any]) -> dict[str, Any]:
     """Figures of finished trials (objects with outcome, reason, error_m, time_to_hold_s and
     events); the same set of trials gives the same summary whatever order they came in."""
     trials = sorted(trials, key=lambda t: t.index)
@@ -72,7 +72,7 @@ def summary(trials: Sequence[Any]) -> dict:
             "by_fault": dict(sorted(by_fault.items())), "reasons": dict(sorted(reasons.items()))}
 
 
-def lines(s: dict) -> list[str]:
+def lines(s: dict[str, Any]) -> list[str]:
     """The summary in words, one figure a line."""
     lo, hi = s["hold_rate_wilson95"]
     out = [f"held {s['held']}/{s['trials']} ({s['hold_rate']:.1%}, Wilson 95 % {lo:.1%}-"
@@ -90,7 +90,7 @@ def lines(s: dict) -> list[str]:
     return out
 
 
-def plot(path: Path, s: dict, trials: Sequence[Any]) -> None:
+def plot(path: Path, s: dict[str, Any], trials: Sequence[Any]) -> None:
     """Outcomes with the hold rate's interval, |error| and time-to-hold distributions, and the
     outcomes by fault kind, in one PNG (written atomically)."""
     import io

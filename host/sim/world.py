@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -92,7 +93,7 @@ class World:
         self.travelled_m = 0.0
 
     @classmethod
-    def for_size(cls, width: int, height: int, **kw) -> World:
+    def for_size(cls, width: int, height: int, **kw: Any) -> World:
         return cls(Geometry.minoru_default(width, height), (width, height), **kw)
 
     def nearest_box(self) -> Box:
