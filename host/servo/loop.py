@@ -55,7 +55,7 @@ from host.servo.perception import (
     stopping_distance_m,
     without_floor,
 )
-from host.servo.recovery import LANE, MOVED, RESET, RESUME, TARGET, Recovery, no_recovery
+from host.servo.recovery import LANE, MOVED, RESET, RESUME, TARGET, Recovery, servo_bounds
 from host.servo.recovery import OUTSIDE as OUTSIDE_KIND
 from host.servo.rereference import refit_floor
 from host.servo.rig import reference_image, vertical_shift_px
@@ -91,6 +91,8 @@ class ServoConfig:
     lane_margin_m: float = 0.05  # watched beyond the stopping distance
     lane_stop_s: float = 3.0  # an object in the lane this long ends the run (recover=False)
     recover: bool = True  # wait out and recover from what passes (host/servo/recovery.py)
+    rereference: bool = False  # and re-reference after the camera moved: off until the
+    # collision it led to (seed 8 trial 45: knock, freeze, decoy) is understood
     moved_rows: float = 0.005  # of the focal length (0.3 degrees of pitch): the camera moved
     acquire_tries: int = 3  # look-alikes that do not move, left out one after the other
     lane_width_px: int = 320  # the lane is watched on frames scaled down to about this width
@@ -177,7 +179,8 @@ class Servo:
         self._cmd = Command(0, 0, "wait", None)  # the command in force
         self._statics: list[tuple[float, float]] = []  # where non-moving look-alikes stand
         self._width = 0
-        self.recovery = Recovery(None if self.cfg.recover else no_recovery(self.cfg.lane_stop_s))
+        self.recovery = Recovery(servo_bounds(self.cfg.recover, self.cfg.rereference,
+                                              self.cfg.lane_stop_s))
         self._reref: list[np.ndarray] = []  # the re-reference's maps so far (robot left out)
         self._reref_fails = 0  # re-references that failed, in this wait
         self._targets_before: list[Target] = []  # the targets a nearer object replaced

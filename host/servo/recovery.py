@@ -59,6 +59,14 @@ def no_recovery(lane_stop_s: float) -> dict[str, Bound]:
     return {**{k: Bound(0.0, 0.0, 0) for k in BOUNDS}, LANE: Bound(lane_stop_s, 1.0, 1 << 30)}
 
 
+def servo_bounds(recover: bool, rereference: bool, lane_stop_s: float) -> dict[str, Bound]:
+    """The servo's bounds: BOUNDS, without the re-reference unless asked for (a moved camera
+    then ends the run at once, as before recovery existed); none at all without recover."""
+    if not recover:
+        return no_recovery(lane_stop_s)
+    return dict(BOUNDS) if rereference else {**BOUNDS, MOVED: Bound(0.0, 0.0, 0)}
+
+
 class Recovery:
     """At most one wait at a time (the first condition met); `fault` says why the run ends."""
 

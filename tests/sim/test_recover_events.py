@@ -57,7 +57,7 @@ BOOT_LOST = LinkFaults(reset_at_ms=3000, reset_cause=int(gen.ResetCause.WATCHDOG
 
 @pytest.mark.parametrize("angle", [1.5, -2.0], ids=["down 1.5 deg", "up 2 deg"])
 def test_a_knocked_camera_is_re_referenced_and_the_robot_holds(angle):
-    r = run((Event(2.0, "knock", angle_deg=angle),))
+    r = run((Event(2.0, "knock", angle_deg=angle),), bounds=BOUNDS)  # re-reference on
     _held(r, MOVED)
     assert any(n.startswith("re-referenced") for n in r.notes)
 
@@ -87,3 +87,13 @@ def test_a_camera_knocked_more_often_than_the_bound_ends_the_run_with_its_reason
     assert "the camera moved since the reference" in r.reason
     assert r.reason.endswith("(the second time in this run)"), r.reason
     assert not math.isnan(r.error_m)
+
+
+def test_at_the_defaults_a_knocked_camera_ends_the_run_with_its_reason():
+    """The re-reference is off by default (ServoConfig.rereference): after it, one trial of the
+    seed-8 campaign (knock, freeze, decoy) drove into the object; until that is understood a
+    moved camera ends the run, a safe stop that names it."""
+    r = run((Event(2.0, "knock", angle_deg=1.5),))
+    assert r.how == "stopped"
+    assert "the camera moved since the reference" in r.reason, r.reason
+    assert MOVED not in r.recovered
