@@ -249,13 +249,19 @@ class Servo:
         g = self.geometry
         self._lane_geometry = Geometry(g.focal_px / k, g.baseline_m, (g.cx + 0.5) / k - 0.5,
                                        (g.cy + 0.5) / k - 0.5)
-        self._lane_reference = (self.reference_map if k == 1 else cv2.resize(
-            self.reference_map, (w // k, h // k), interpolation=cv2.INTER_NEAREST) / k)
+        self._lane_reference = self._lane_map(self.reference_map)
         self.tracker = TargetTracker(target, min_area, self.cfg.tracker)
         self.controller = Controller(self.geometry.depth_m(target.disparity), self.control)
         self.controller.keep_out = self._extent(
             object_extent(without_floor(self.reference_map, self.floor), target))
         return target
+
+    def _lane_map(self, reference: np.ndarray) -> np.ndarray:
+        """A reference map at the lane's scale (its disparities scaled with it)."""
+        k = self._lane_scale
+        h, w = reference.shape
+        return reference if k == 1 else cv2.resize(
+            reference, (w // k, h // k), interpolation=cv2.INTER_NEAREST) / k
 
     def _extent(self, target: Target) -> tuple[float, float]:
         """The object's lateral extent (m) at its depth, from its image region; a side cut by
@@ -701,10 +707,7 @@ class Servo:
             return f"the target's region does not agree in both views ({agree:.2f})"
         self.floor, self.reference_map = floor, reference
         self._reference_image = reference_image(frame.left)
-        k = self._lane_scale
-        h, w = reference.shape
-        self._lane_reference = (reference if k == 1 else cv2.resize(
-            reference, (w // k, h // k), interpolation=cv2.INTER_NEAREST) / k)
+        self._lane_reference = self._lane_map(reference)
         self.tracker = TargetTracker(target, self.tracker.min_area, self.cfg.tracker)
         self._targets_before.clear()
         self.controller.target_m = self.geometry.depth_m(target.disparity)
