@@ -12,7 +12,6 @@ import time
 from pathlib import Path
 
 from host.camera.open import add_camera_options, open_source, parse_size, source_geometry
-from host.commands.held_signals import signals_held
 from host.commands.options import (
     COUNT,
     FRACTION,
@@ -35,6 +34,7 @@ from host.servo.controller import ControlConfig
 from host.servo.loop import Servo
 from host.servo.report import plot_run, write_csv
 from host.servo_run import ENDED, NOT_SETTLED, Rules, run_servo
+from host.signals import signals_held
 
 UNO_FLASH = Path("uno-flash.bin")  # --robot uno's flash file when --flash is not given
 
