@@ -35,6 +35,9 @@ class MarkerPair:
         return self.left.u - self.right.u
 
 
+_OPEN = np.ones((2, 2), np.uint8)  # the opening that removes one-pixel specks of the mask
+
+
 def _p90(patch: np.ndarray) -> float:
     """np.percentile(patch, 90) of a uint8 array, exactly (its linear interpolation between
     the order statistics on each side), from the histogram instead of a partition."""
@@ -72,11 +75,12 @@ def find_discs(image: np.ndarray, min_radius: float = 2.5, max_radius: float = 8
     """Dark, round blobs inside a lighter ring; window (px, odd) is the neighbourhood the disc
     is darker than, and must be wider than the disc (find_marker sizes it)."""
     grey = to_grey(image)
-    # dark relative to the neighbourhood: the ring makes the disc stand out locally
+    # dark relative to the neighbourhood: the ring makes the disc stand out locally (grey <
+    # local - 40; where local < 40 the saturated difference is 0 and nothing is below it)
     local = cv2.blur(grey, (window, window))
-    mask = (grey.astype(np.int16) < local.astype(np.int16) - 40).astype(np.uint8)
-    mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, np.ones((2, 2), np.uint8))
-    blobs = []
+    mask = cv2.compare(grey, cv2.subtract(local, 40), cv2.CMP_LT)  # 255 where dark
+    mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, _OPEN)
+    blobs: list[Blob] = []
     min_area = math.pi * min_radius ** 2
     outlines = _outlines(mask, min_area)
     if not outlines:
