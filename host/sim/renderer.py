@@ -95,6 +95,37 @@ def _coverage(qx: np.ndarray, qy: np.ndarray, ts: tuple[float, ...]) -> list[np.
     return covs
 
 
+LensBounds = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+
+def _lens_bounds(mx: np.ndarray, my: np.ndarray) -> LensBounds:
+    """Per row, the least and greatest source column (mx) of the lens map, and per column the
+    least and greatest source row (my)."""
+    return mx.min(1), mx.max(1), my.min(0), my.max(0)
+
+
+def _lens_hit_box(bounds: LensBounds, mx: np.ndarray, my: np.ndarray,
+                  limits: tuple[float, float, float, float]) -> tuple[int, int, int, int] | None:
+    """The rows y0:y1 and columns x0:x1 round the pixels whose lens source (mx, my) lies
+    strictly inside limits (lo_x, hi_x, lo_y, hi_y), None if none does: the pixels are looked
+    for only in the rows whose source columns reach into (lo_x, hi_x) and the columns whose
+    source rows reach into (lo_y, hi_y), where every such pixel is."""
+    lo_x, hi_x, lo_y, hi_y = limits
+    row_min, row_max, col_min, col_max = bounds
+    rows = np.flatnonzero((row_max > lo_x) & (row_min < hi_x))
+    cols = np.flatnonzero((col_max > lo_y) & (col_min < hi_y))
+    if not rows.size or not cols.size:
+        return None
+    ra, rb, ca, cb = int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1
+    sx, sy = mx[ra:rb, ca:cb], my[ra:rb, ca:cb]
+    hit = (sx > lo_x) & (sx < hi_x) & (sy > lo_y) & (sy < hi_y)
+    hit_rows, hit_cols = np.flatnonzero(hit.any(1)), np.flatnonzero(hit.any(0))
+    if not hit_rows.size:
+        return None
+    return (ra + int(hit_rows[0]), ra + int(hit_rows[-1]) + 1,
+            ca + int(hit_cols[0]), ca + int(hit_cols[-1]) + 1)
+
+
 class Renderer:
     def __init__(self, world: World, camera: CameraFaults = CameraFaults(), seed: int = 0
                  ) -> None:
@@ -113,6 +144,7 @@ class Renderer:
         self._bare_key: tuple | None = None  # the layout _bare_images are of
         self._bare_images: dict[tuple[int, int | None], np.ndarray] = {}
         self._lens = [lens_maps(world, k1) for k1 in camera.distortion]
+        self._lens_bounds = [None if m is None else _lens_bounds(*m) for m in self._lens]
         w, h = world.size
         # sensor noise: a bank of independent fields, one drawn at random per view (drawing a
         # fresh field per view costs more than the rest of the rendering)
@@ -401,20 +433,25 @@ class Renderer:
         key = ("before lens", side, k)
         if key not in self._bare_images:
             self._bare_images[key] = self._before_lens(self._static[side][0], side, k)
-        src = self._bare_images[key].copy()
-        src[r0:r1, c0:c1] = self._before_lens(img[r0:r1, c0:c1], side, k, (r0, r1, c0, c1))
+        src = self._bare_images[key]
         mx, my = self._lens[side]
         # a source pixel on the image's edge also stands for the ones beyond it (replicated)
         h, w = mx.shape
         lo_x, hi_x = (-math.inf if c0 == 0 else c0 - 2), (math.inf if c1 >= w else c1 + 1)
         lo_y, hi_y = (-math.inf if r0 == 0 else r0 - 2), (math.inf if r1 >= h else r1 + 1)
-        hit = (mx > lo_x) & (mx < hi_x) & (my > lo_y) & (my < hi_y)
-        rows, cols = np.flatnonzero(hit.any(1)), np.flatnonzero(hit.any(0))
-        if not rows.size:
+        box = _lens_hit_box(self._lens_bounds[side], mx, my, (lo_x, hi_x, lo_y, hi_y))
+        if box is None:
             return out
-        y0, y1, x0, x1 = int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1
-        part = cv2.remap(src, mx[y0:y1, x0:x1], my[y0:y1, x0:x1], cv2.INTER_LINEAR,
-                         borderMode=cv2.BORDER_REPLICATE)
+        y0, y1, x0, x1 = box
+        # the drawn rectangle goes into the bare scene's image for the remap and is taken out
+        # again: the same source as a copy with the rectangle in it, without copying the rest
+        kept = src[r0:r1, c0:c1].copy()
+        src[r0:r1, c0:c1] = self._before_lens(img[r0:r1, c0:c1], side, k, (r0, r1, c0, c1))
+        try:
+            part = cv2.remap(src, mx[y0:y1, x0:x1], my[y0:y1, x0:x1], cv2.INTER_LINEAR,
+                             borderMode=cv2.BORDER_REPLICATE)
+        finally:
+            src[r0:r1, c0:c1] = kept
         cv2.max(part, 0.0, dst=part)
         out[y0:y1, x0:x1] = cv2.convertScaleAbs(part)
         return out
