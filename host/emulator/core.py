@@ -76,6 +76,8 @@ class FirmwareCore:
         self._lib.emu_motors.argtypes = [ctypes.POINTER(ctypes.c_int16)] * 2
         self._lib.emu_motors.restype = ctypes.c_uint32
         self._buf = ctypes.create_string_buffer(4096)
+        self._left, self._right = ctypes.c_int16(), ctypes.c_int16()
+        self._motor_refs = ctypes.byref(self._left), ctypes.byref(self._right)
         self._lib.robot_init(reset_cause, now_ms)
 
     def rx(self, data: bytes, now_ms: int) -> None:
@@ -90,10 +92,9 @@ class FirmwareCore:
 
     def take_tx(self) -> bytes:
         n = self._lib.emu_take_tx(self._buf, len(self._buf))
-        return self._buf.raw[:n]
+        return self._buf.raw[:n] if n else b""  # .raw copies the whole buffer: not for none
 
     def motors(self) -> tuple[int, int]:
         """Applied duty (permille) of the left and right motor."""
-        left, right = ctypes.c_int16(), ctypes.c_int16()
-        self._lib.emu_motors(ctypes.byref(left), ctypes.byref(right))
-        return left.value, right.value
+        self._lib.emu_motors(*self._motor_refs)
+        return self._left.value, self._right.value

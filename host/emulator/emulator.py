@@ -147,7 +147,7 @@ class Emulator:
 
     def _collect(self) -> None:
         data = self._core.take_tx()
-        if self.silent:
+        if not data or self.silent:
             return
         for b in self._faulty(data, TO_HOST):
             if self.line_rate:

@@ -15,6 +15,17 @@ from host.sim.renderer import Flicker, Renderer
 from host.sim.world import Box, Person, Robot, World
 
 
+def _first_ms(t_s: float) -> int:
+    """The first whole millisecond n whose time n / 1000 (as SimSource.t computes it) is at
+    or after t_s."""
+    n = math.ceil(t_s * 1000)
+    while (n - 1) / 1000 >= t_s:
+        n -= 1
+    while n / 1000 < t_s:
+        n += 1
+    return n
+
+
 class SimSource(StereoSource):
     """Frames at fps; between frames the world and the board advance in 1 ms steps, the robot
     driven by the duties the firmware applies, latency_ms later. The first reference_frames
@@ -40,6 +51,7 @@ class SimSource(StereoSource):
         self._due_ms = 0  # the left capture of the frame being read
         self._pending: deque[tuple[int, tuple[int, int]]] = deque()
         self._applied = (0, 0)
+        self._queued: tuple[int, int] | None = None  # the motor outputs queued last
         self._occluded_until = -1.0
         self._until: dict[str, float] = {}  # when each lasting event ends
         self._lane_box: Box | None = None
@@ -61,15 +73,39 @@ class SimSource(StereoSource):
         return self._freeze is not None
 
     def run_ms(self, ms: int) -> None:
-        """Advance the world and the board by ms, one millisecond at a time."""
+        """Advance the world and the board by ms, one millisecond at a time. The scene's events
+        are looked at in the milliseconds where one is due (_wake_ms), and the motor outputs
+        are queued for their latency only when they change: the same steps as looking every
+        millisecond and queueing every output."""
+        board, step, pending = self.board, self.world.step, self._pending
+        latency = int(round(self.latency_ms))
+        wake = self._wake_ms()
         for _ in range(ms):
-            self._apply_events()
-            self._pending.append((self.now_ms + int(round(self.latency_ms)), self.board.motors()))
-            while self._pending and self._pending[0][0] <= self.now_ms:
-                self._applied = self._pending.popleft()[1]
-            self.world.step(0.001, *self._applied)
-            self.board.advance(1)
-            self.now_ms += 1
+            now = self.now_ms
+            if now >= wake:
+                self._apply_events()
+                wake = self._wake_ms()
+            motors = board.motors()
+            if motors != self._queued:
+                pending.append((now + latency, motors))
+                self._queued = motors
+            while pending and pending[0][0] <= now:
+                self._applied = pending.popleft()[1]
+            step(0.001, *self._applied)
+            board.advance(1)
+            self.now_ms = now + 1
+
+    def _wake_ms(self) -> float:
+        """The first millisecond at which _apply_events has something to do: an event due, a
+        lasting one or the post's occlusion ending, every millisecond while a person walks."""
+        if self._walker is not None:
+            return self.now_ms
+        times = [*self._until.values()]
+        if self.events:
+            times.append(self.events[0].t_s)
+        if self.world.robot.occlusion:
+            times.append(self._occluded_until)
+        return min(map(_first_ms, times), default=math.inf)
 
     def _apply_events(self) -> None:
         w, r = self.world, self.world.robot
