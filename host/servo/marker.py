@@ -16,6 +16,8 @@ import numpy as np
 
 from host.stereo.grey import to_grey
 
+Window = tuple[int, int, int, int]  # x0, y0, x1, y1: a search window, columns x0:x1, rows y0:y1
+
 
 @dataclass(frozen=True)
 class Blob:
@@ -78,7 +80,7 @@ def find_discs(image: np.ndarray, min_radius: float = 2.5, max_radius: float = 8
     # dark relative to the neighbourhood: the ring makes the disc stand out locally (grey <
     # local - 40; where local < 40 the saturated difference is 0 and nothing is below it)
     local = cv2.blur(grey, (window, window))
-    mask = cv2.compare(grey, cv2.subtract(local, 40), cv2.CMP_LT)  # 255 where dark
+    mask = cv2.compare(grey, cv2.subtract(local, np.full_like(local, 40)), cv2.CMP_LT)  # 255: dark
     mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, _OPEN)
     blobs: list[Blob] = []
     min_area = math.pi * min_radius ** 2
@@ -157,8 +159,8 @@ def find_aruco(image: np.ndarray) -> list[Blob]:
 
 
 def find_markers(left: np.ndarray, right: np.ndarray, kind: str = "disc",
-                 max_row_error: float = 2.0, windows: tuple | None = None, window: int = 31
-                 ) -> list[MarkerPair]:
+                 max_row_error: float = 2.0, windows: tuple[Window, Window] | None = None,
+                 window: int = 31) -> list[MarkerPair]:
     """Candidate marker pairs in a rectified pair: a left blob and a right blob on the same row
     to its left (positive disparity) with a similar size. windows: ((x0, y0, x1, y1) left,
     (x0, y0, x1, y1) right) to search in, else the whole images."""
@@ -184,7 +186,7 @@ def find_markers(left: np.ndarray, right: np.ndarray, kind: str = "disc",
     return pairs
 
 
-def _window(blob: Blob, shape: tuple[int, ...]) -> tuple[int, int, int, int]:
+def _window(blob: Blob, shape: tuple[int, ...]) -> Window:
     reach = int(4 * blob.radius) + 24  # room for the frame-to-frame motion
     h, w = shape[:2]
     return (max(0, int(blob.u) - reach), max(0, int(blob.v) - reach),

@@ -60,7 +60,8 @@ def rotation_homography(world: World, pitch_deg: float) -> np.ndarray:
     g, a = world.geometry, math.radians(pitch_deg)
     k = np.array([[g.focal_px, 0, g.cx], [0, g.focal_px, g.cy], [0, 0, 1]], np.float64)
     rt = np.array([[1, 0, 0], [0, math.cos(a), -math.sin(a)], [0, math.sin(a), math.cos(a)]])
-    return k @ rt @ np.linalg.inv(k)
+    hom: np.ndarray = k @ rt @ np.linalg.inv(k)
+    return hom
 
 
 def lens_maps(world: World, k1: float) -> tuple[np.ndarray, np.ndarray] | None:
@@ -132,7 +133,7 @@ class Renderer:
         self.world, self.camera = world, camera
         self.rng = np.random.default_rng(seed)
         self.seed = seed
-        self._static_key: tuple | None = None
+        self._static_key: tuple[object, ...] | None = None
         self._static: list[tuple[np.ndarray, np.ndarray]] = []
         self._body_tex = random_texture(np.random.default_rng(seed + 1), 64, 64, 1.2, 45, 110)
         self._person_tex = random_texture(np.random.default_rng(seed + 2), 256, 256, 2.0, 50, 120)
@@ -141,8 +142,8 @@ class Renderer:
         self._row0 = 0  # rows of the canvas above the view's first (a pitched rig sees them)
         self.flicker: Flicker | None = None
         self._touched: list[tuple[int, int, int, int]] = []  # rows, columns drawn this view
-        self._bare_key: tuple | None = None  # the layout _bare_images are of
-        self._bare_images: dict[tuple[int, int | None], np.ndarray] = {}
+        self._bare_key: tuple[object, ...] | None = None  # the layout _bare_images are of
+        self._bare_images: dict[tuple[object, ...], np.ndarray] = {}
         self._lens = [lens_maps(world, k1) for k1 in camera.distortion]
         self._lens_bounds = [None if m is None else _lens_bounds(*m) for m in self._lens]
         w, h = world.size
@@ -254,7 +255,8 @@ class Renderer:
             self._blur(image, (min(x0, u - 2 * ry) - shift * d, min(y0, v - 2 * ry),
                                        max(x1, u + 2 * ry) - shift * d, y1), blur_px)
 
-    def _blur(self, image: np.ndarray, box, blur_px) -> None:
+    def _blur(self, image: np.ndarray, box: tuple[float, float, float, float],
+              blur_px: tuple[float, float]) -> None:
         """Motion blur over the robot's region: the image averaged along its motion (px over
         the exposure); the background it passes over takes part, as on a sensor."""
         h, w = image.shape
@@ -273,7 +275,8 @@ class Renderer:
         region = image[r0:r1, c0:c1]
         region[:] = cv2.filter2D(region, -1, k, borderType=cv2.BORDER_REPLICATE)
 
-    def _paint(self, image, disp, box, d, texture: np.ndarray | None) -> None:
+    def _paint(self, image: np.ndarray, disp: np.ndarray, box: tuple[float, float, float, float],
+               d: float, texture: np.ndarray | None) -> None:
         """A surface at disparity d over box (texture, or a uniform grey 60), where the scene
         is not nearer."""
         h, w = image.shape
@@ -294,7 +297,8 @@ class Renderer:
             image[r0:r1, c0:c1][shown] = 60.0
         disp[r0:r1, c0:c1][shown] = d
 
-    def _marker(self, image, disp, u, v, rx, ry, d, ring) -> None:
+    def _marker(self, image: np.ndarray, disp: np.ndarray, u: float, v: float, rx: float,
+                ry: float, d: float, ring: float) -> None:
         """Dark disc in a light ring, anti-aliased by 4x4 supersampling of each pixel."""
         if rx < 0.5:
             return
@@ -329,7 +333,7 @@ class Renderer:
         world = self.world
         self._row0 = (img.shape[0] - world.size[1]) // 2
         self._touched = []
-        things: list[tuple[float, object]] = [(p.z_m, p) for p in world.people]
+        things: list[tuple[float, Person | Robot]] = [(p.z_m, p) for p in world.people]
         things += [(r.z_m, r) for r in world.decoys]
         if with_robot:
             things.append((world.robot.z_m, world.robot))
@@ -385,13 +389,14 @@ class Renderer:
         img = np.multiply(img, cam.gain[side])  # a new array: img may be the caller's
         np.add(img, cam.bias[side], out=img)
         if k is not None:
+            assert self._noise is not None  # k is a field of the bank
             noise = self._noise[k]
             img += noise if region is None else noise[region[0]:region[1], region[2]:region[3]]
         lens = self._lens[side]
         if lens is None and img.dtype == np.float32:
             # OpenCV's conversion to uint8 rounds half to even and saturates, as rint and clip
             # do, and scales in float32 as numpy does: the same image, without the temporaries
-            cv2.max(img, 0.0, dst=img)  # then |x w| is x w, and what was below 0 is 0 still
+            np.maximum(img, 0.0, out=img)  # then |x w| is x w, and what was below 0 is 0 still
             if not cam.white:
                 return cv2.convertScaleAbs(img)
             return cv2.merge([cv2.convertScaleAbs(img, alpha=float(np.float32(c)))
@@ -401,7 +406,7 @@ class Renderer:
         if lens is not None:
             img = cv2.remap(img.astype(np.float32, copy=False), lens[0], lens[1],
                             cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
-            cv2.max(img, 0.0, dst=img)  # rounded and saturated as above
+            np.maximum(img, 0.0, out=img)  # rounded and saturated as above
             return cv2.convertScaleAbs(img)
         np.rint(img, out=img)
         np.clip(img, 0, 255, out=img)
@@ -415,6 +420,7 @@ class Renderer:
         img = np.multiply(img, cam.gain[side])
         np.add(img, cam.bias[side], out=img)
         if k is not None:
+            assert self._noise is not None  # k is a field of the bank
             noise = self._noise[k]
             img += noise if region is None else noise[region[0]:region[1], region[2]:region[3]]
         if cam.white:
@@ -434,12 +440,14 @@ class Renderer:
         if key not in self._bare_images:
             self._bare_images[key] = self._before_lens(self._static[side][0], side, k)
         src = self._bare_images[key]
-        mx, my = self._lens[side]
+        lens, bounds = self._lens[side], self._lens_bounds[side]
+        assert lens is not None and bounds is not None  # view() sends lens views only
+        mx, my = lens
         # a source pixel on the image's edge also stands for the ones beyond it (replicated)
         h, w = mx.shape
         lo_x, hi_x = (-math.inf if c0 == 0 else c0 - 2), (math.inf if c1 >= w else c1 + 1)
         lo_y, hi_y = (-math.inf if r0 == 0 else r0 - 2), (math.inf if r1 >= h else r1 + 1)
-        box = _lens_hit_box(self._lens_bounds[side], mx, my, (lo_x, hi_x, lo_y, hi_y))
+        box = _lens_hit_box(bounds, mx, my, (lo_x, hi_x, lo_y, hi_y))
         if box is None:
             return out
         y0, y1, x0, x1 = box
@@ -452,7 +460,7 @@ class Renderer:
                              borderMode=cv2.BORDER_REPLICATE)
         finally:
             src[r0:r1, c0:c1] = kept
-        cv2.max(part, 0.0, dst=part)
+        np.maximum(part, 0.0, out=part)
         out[y0:y1, x0:x1] = cv2.convertScaleAbs(part)
         return out
 

@@ -73,7 +73,7 @@ class SimRun:
 
 @contextlib.contextmanager
 def simulation(setup: Setup = Setup(), reference: bool = True) -> Iterator[SimRun]:
-    kw = {} if setup.boxes is None else {"boxes": setup.boxes}
+    kw: dict[str, Any] = {} if setup.boxes is None else {"boxes": setup.boxes}
     faults = setup.faults
     world = World.for_size(*setup.size, seed=setup.seed, motor_faults=faults.motor, **kw)
     r = world.robot
