@@ -207,6 +207,9 @@ def marker_candidates(left: np.ndarray, right: np.ndarray, kind: str = "disc",
         expected = radius_m * p.disparity / baseline_m
         return abs(p.left.radius - expected) <= 0.35 * expected
 
+    # grey once for the up to three searches below (the same grey levels as each search's
+    # own conversion of its window: the conversion is pixel by pixel)
+    left, right = to_grey(left), to_grey(right)
     pairs = []
     if near is not None and not whole:
         windows = (_window(near.left, left.shape), _window(near.right, right.shape))
