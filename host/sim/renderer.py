@@ -100,21 +100,22 @@ LensBounds = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
 
 def _lens_bounds(mx: np.ndarray, my: np.ndarray) -> LensBounds:
-    """Per row, the least and greatest source column (mx) of the lens map, and per column the
-    least and greatest source row (my)."""
-    return mx.min(1), mx.max(1), my.min(0), my.max(0)
+    """Per row of the view, the least and greatest source row (my) of the lens map; per
+    column, the least and greatest source column (mx). A mild lens bends each row and column
+    by a few pixels only, so these ranges are narrow."""
+    return my.min(1), my.max(1), mx.min(0), mx.max(0)
 
 
 def _lens_hit_box(bounds: LensBounds, mx: np.ndarray, my: np.ndarray,
                   limits: tuple[float, float, float, float]) -> tuple[int, int, int, int] | None:
     """The rows y0:y1 and columns x0:x1 round the pixels whose lens source (mx, my) lies
-    strictly inside limits (lo_x, hi_x, lo_y, hi_y), None if none does: the pixels are looked
-    for only in the rows whose source columns reach into (lo_x, hi_x) and the columns whose
-    source rows reach into (lo_y, hi_y), where every such pixel is."""
+    strictly inside limits (lo_x, hi_x, lo_y, hi_y), None if none does. Such a pixel is in a
+    row whose source rows reach into (lo_y, hi_y) and a column whose source columns reach
+    into (lo_x, hi_x): the pixels are looked for in those rows and columns alone."""
     lo_x, hi_x, lo_y, hi_y = limits
-    row_min, row_max, col_min, col_max = bounds
-    rows = np.flatnonzero((row_max > lo_x) & (row_min < hi_x))
-    cols = np.flatnonzero((col_max > lo_y) & (col_min < hi_y))
+    row_lo, row_hi, col_lo, col_hi = bounds
+    rows = np.flatnonzero((row_hi > lo_y) & (row_lo < hi_y))
+    cols = np.flatnonzero((col_hi > lo_x) & (col_lo < hi_x))
     if not rows.size or not cols.size:
         return None
     ra, rb, ca, cb = int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1
