@@ -207,15 +207,14 @@ def marker_candidates(left: np.ndarray, right: np.ndarray, kind: str = "disc",
         expected = radius_m * p.disparity / baseline_m
         return abs(p.left.radius - expected) <= 0.35 * expected
 
-    # grey once for the up to three searches below (the same grey levels as each search's
-    # own conversion of its window: the conversion is pixel by pixel)
-    left, right = to_grey(left), to_grey(right)
     pairs = []
     if near is not None and not whole:
         windows = (_window(near.left, left.shape), _window(near.right, right.shape))
         size = max(31, 2 * int(3 * near.left.radius) + 1)
         pairs = [p for p in find_markers(left, right, kind, windows=windows, window=size)
                  if fits(p)]
+    if not pairs:  # the whole views, in grey once for both sizes (pixel by pixel: the same)
+        left, right = to_grey(left), to_grey(right)
     for size in (31, 121):
         if pairs:
             break
