@@ -3,7 +3,8 @@
 set -euo pipefail
 packages=(gcc make gcc-avr avr-libc binutils-avr simavr libsimavr-dev avrdude
           arduino-core-avr # the Uno's bootloader (optiboot) for the simulated Uno
-          clang)           # libFuzzer with ASan and UBSan (tools/fuzz.py)
+          clang            # libFuzzer with ASan and UBSan (tools/fuzz.py) ...
+          libclang-rt-dev) # ... and their runtimes, which clang only recommends
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -122,11 +122,11 @@ def firmware_elf(test_hang: bool = False, firmware: Path | None = None) -> Path:
 def simavr_program(source: Path, name: str, out_dir: Path | None = None,
                    includes: tuple[Path, ...] = ()) -> Path:
     """Compile one simavr program (harness.c, uno.c) against libsimavr into out_dir (default:
-    the cache), keyed by a hash of what it is built from; renamed into place, so a running
-    program keeps its file."""
+    the cache), keyed by a hash of what it is built from (the headers beside it too: the two
+    programs' common.h); renamed into place, so a running program keeps its file."""
     need_sources(source)
     need_simavr()
-    headers = [h for d in includes for h in sorted(d.glob("*.h"))]
+    headers = [h for d in (source.parent, *includes) for h in sorted(d.glob("*.h"))]
     out_dir = out_dir or CACHE / "simavr"
     exe = out_dir / f"{name}-{digest([source, *headers])}"
     if exe.exists():

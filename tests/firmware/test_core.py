@@ -29,9 +29,11 @@ def send(core, seq: int, msg, now: int) -> list:
 
 
 def test_a_resend_handled_right_after_a_trip_is_applied_not_a_duplicate(core) -> None:
-    """no-catch-up-before-a-frame: the timer interrupt trips, and before the main loop's next
-    tick a resend of the last SET_DRIVE is handled: the stop is caught up first, so the resend
-    is applied (ACK APPLIED, motors driven) instead of acknowledged while the motors stay off."""
+    """The timer interrupt trips, and before the main loop's next tick a resend of the last
+    SET_DRIVE is handled: the stop is caught up first, so the resend is applied (ACK APPLIED,
+    motors driven) instead of acknowledged while the motors stay off. (on_set_drive's own
+    catch-up holds this too, so no-catch-up-before-a-frame is killed at the wire instead:
+    test_races.py::test_a_trip_as_a_status_request_comes_in_is_in_its_answer.)"""
     send(core, 0, gen.SetConfig(link_timeout_ms=250, accel_limit=0), 1)
     assert send(core, 7, gen.SetDrive(left=400, right=400), 2)[-1].result == gen.AckResult.APPLIED
     core.tick(3)

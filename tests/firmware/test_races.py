@@ -11,7 +11,7 @@ import subprocess
 import pytest
 
 from host.emulator.pins import timeline
-from host.emulator.simavr import F_CPU, SimRun, parse
+from host.emulator.simavr import CYCLES_PER_BYTE, F_CPU, SimRun, parse
 from host.link import protocol_gen as gen
 from host.link.frame import encode_frame
 from host.link.messages import pack, unpack
@@ -37,6 +37,24 @@ def sweep(harness, elf, before: list[str], n: int, after: list[str]) -> list[Sim
     assert len(starts) == n, f"{len(starts)} trials of {n}"
     prefix = lines[:starts[0]]
     return [parse(prefix + lines[a:b]) for a, b in zip(starts, [*starts[1:], len(lines)])]
+
+
+def forced_cycles(harness, elf, before: list[str], n: int, after: list[str]) -> list[tuple[int,
+                                                                                        SimRun]]:
+    """As sweep, each trial with the cycle at which its extra tick was raised (harness.c:
+    "force CYCLE"; the CPU takes it as soon as interrupts are on)."""
+    text = "\n".join([*before, f"sweep {n}", *after]) + "\n"
+    out = subprocess.run([str(harness), str(elf)], input=text, capture_output=True, text=True,
+                         timeout=600)
+    assert out.returncode == 0, out.stderr[-500:]
+    lines = out.stdout.splitlines()
+    starts = [i for i, line in enumerate(lines) if line.startswith("trial ")]
+    assert len(starts) == n, f"{len(starts)} trials of {n}"
+    trials = []
+    for a, b in zip(starts, [*starts[1:], len(lines)]):
+        force = next(int(x.split()[1]) for x in lines[a:b] if x.startswith("force "))
+        trials.append((force, parse(lines[:starts[0]] + lines[a:b])))
+    return trials
 
 
 def messages(r: SimRun) -> list:
@@ -158,3 +176,35 @@ def test_a_drive_acknowledged_at_the_deadline_is_still_driven(harness, firmware_
         if not ok:
             bad.append((k, ack.result, status))
     assert not bad, f"{len(bad)} of {len(trials)} trials: first {bad[0]}"
+
+
+def test_a_trip_as_a_status_request_comes_in_is_in_its_answer(harness, firmware_elf) -> None:
+    """no-catch-up-before-a-frame: the main loop hands the core the received bytes before its
+    tick, so a trip taken as a frame's last byte comes in is handled by the core before the
+    tick's catch-up. The last byte of a GET_STATUS arrives 1 ms before the deadline of the drive
+    in force, the extra tick (which trips the guard) landing at each instruction from there
+    on. Every trial whose trip came within 200 cycles of that byte's stop bit, before the
+    firmware can have parsed and checked the frame (the CRC-32C of its last byte alone takes
+    longer; the catch-up came some 900 cycles after it, measured), must be answered with the
+    stop: LINK_LOST, one link loss, duty 0. Without the catch-up before the frame, STATUS said
+    "not driving, no link loss, duty 500" while the motors were cut."""
+    status = encode_frame(3, *pack(gen.GetStatus()))
+    # the drive is heard in ms h; the status's last byte arrives in ms h + 50, where the extra
+    # tick makes the count h + 51: the guard trips at the tick
+    before = ["run 2", frame(0, gen.SetConfig(link_timeout_ms=50, accel_limit=0)), "run 2",
+              frame(1, DRIVE), "run 51", f"send {status[:-1].hex()}", "run 0.7"]
+    after = [f"send {status[-1:].hex()}", "run 8"]
+    trials = forced_cycles(harness, firmware_elf, before, 800, after)
+    early, bad, driving = 0, [], 0
+    for k, (force, r) in enumerate(trials):
+        s = status_of(r)
+        assert s is not None, f"trial {k}: no STATUS"
+        driving += bool(s.flags & gen.StatusFlag.DRIVING)
+        if force <= r.ins[-1][0] + CYCLES_PER_BYTE + 200:
+            early += 1
+            if not (s.flags & gen.StatusFlag.LINK_LOST and s.link_losses == 1 and
+                    (s.left, s.right) == (0, 0)):
+                bad.append((k, force - r.ins[-1][0] - CYCLES_PER_BYTE, s))
+    assert early > 20, f"only {early} trials tripped as the byte came in"
+    assert driving, "the deadline was not at the sweep: no trial tripped after the answer"
+    assert not bad, f"{len(bad)} of {early} trials: first {bad[0]}"

@@ -45,17 +45,14 @@
 #include <stdlib.h>
 #include <string.h>
 #include <termios.h>
-#include <time.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <simavr/avr_uart.h>
-#include <simavr/sim_avr.h>
 #include <simavr/sim_elf.h>
 
+#include "common.h"
 #include "protocol_gen.h"
 
-#define F_CPU 16000000UL
 #define CYCLES_PER_BYTE (10UL * F_CPU / PROTO_BAUD) /* the host's line: 10 bits a byte */
 #define TIMER0_COMPA_VECTOR 14                        /* ATmega328P interrupt vector number */
 
@@ -81,8 +78,8 @@ static const struct {
 
 static struct {
     avr_t *avr;
-    avr_irq_t *uart_in;
-    int xon, flow, feeding;
+    struct uart0 uart;
+    int flow, feeding;
     uint8_t *queue; /* bytes waiting for UART0: queue[q_head..q_tail) */
     size_t q_head, q_tail, q_cap;
     avr_cycle_count_t next_in;
@@ -108,23 +105,6 @@ static void on_tx(struct avr_irq_t *irq, uint32_t value, void *param)
     }
 }
 
-static void on_xon(struct avr_irq_t *irq, uint32_t value, void *param)
-{
-    (void)irq, (void)value, (void)param;
-    h.xon = 1;
-}
-
-static void on_xoff(struct avr_irq_t *irq, uint32_t value, void *param)
-{
-    (void)irq, (void)value, (void)param;
-    h.xon = 0;
-}
-
-static void no_sleep(avr_t *avr, avr_cycle_count_t how_long)
-{
-    (void)avr, (void)how_long; /* scripted mode runs as fast as it can */
-}
-
 /* Cycle timer: one byte into UART0 per byte time while the queue has bytes. A timer, not a
  * check between instructions, so a byte arrives on time also while the CPU sleeps. */
 static avr_cycle_count_t inject(struct avr_t *avr, avr_cycle_count_t when, void *param)
@@ -134,13 +114,13 @@ static avr_cycle_count_t inject(struct avr_t *avr, avr_cycle_count_t when, void 
         h.feeding = 0;
         return 0;
     }
-    if (h.flow && !h.xon)
+    if (h.flow && !h.uart.xon)
         return when + CYCLES_PER_BYTE / 16; /* the UART is full: look again shortly */
     uint8_t byte = h.queue[h.q_head++];
     h.n_in++;
     if (h.pty_fd < 0 && !h.quiet)
         printf("in %llu %02x\n", (unsigned long long)avr->cycle, byte);
-    avr_raise_irq(h.uart_in, byte);
+    avr_raise_irq(h.uart.in, byte);
     h.next_in = when + CYCLES_PER_BYTE;
     return h.next_in;
 }
@@ -219,7 +199,7 @@ static int step(void)
     }
     if (h.avr->pc == 0 && pc != 0) {
         h.resets++;
-        h.xon = 0; /* hold bytes until the reset firmware enables its UART again */
+        h.uart.xon = 0; /* hold bytes until the reset firmware enables its UART again */
         h.feeding = 0; /* the reset dropped the cycle timers */
         start_feeding();
         fprintf(h.events, "reset %llu\n", (unsigned long long)h.avr->cycle);
@@ -271,13 +251,6 @@ static void queue_hex(const char *hex)
     }
 }
 
-static double wall(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return t.tv_sec + t.tv_nsec * 1e-9;
-}
-
 static void fill(unsigned seed)
 {
     uint32_t x = seed * 2654435761u + 1;
@@ -323,7 +296,7 @@ static void reset_now(unsigned flags)
     memcpy(h.avr->data + 0x100, ram, sizeof ram);
     h.avr->data[0x54] = (uint8_t)flags;
     h.resets++;
-    h.xon = 0;
+    h.uart.xon = 0;
     h.feeding = 0;
     start_feeding();
     fprintf(h.events, "reset %llu\n", (unsigned long long)h.avr->cycle);
@@ -484,8 +457,6 @@ int main(int argc, char **argv)
     h.flow = 1;
     for (size_t i = 0; i < N_WATCHED; i++)
         h.last[i] = ~0u; /* the first step prints the registers at power-on */
-    uint32_t flags = 0; /* no console echo of UART output */
-    avr_ioctl(h.avr, AVR_IOCTL_UART_SET_FLAGS('0'), &flags);
     for (int i = 0; i < h.avr->interrupts.vector_count; i++)
         if (h.avr->interrupts.vector[i]->vector == TIMER0_COMPA_VECTOR)
             h.tick = h.avr->interrupts.vector[i];
@@ -493,17 +464,11 @@ int main(int argc, char **argv)
         fprintf(stderr, "harness: no Timer0 compare vector\n");
         return 2;
     }
-    h.uart_in = avr_io_getirq(h.avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_INPUT);
-    avr_irq_register_notify(avr_io_getirq(h.avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUTPUT),
-                            on_tx, NULL);
-    avr_irq_register_notify(avr_io_getirq(h.avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUT_XON),
-                            on_xon, NULL);
-    avr_irq_register_notify(avr_io_getirq(h.avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUT_XOFF),
-                            on_xoff, NULL);
+    uart0_wire(h.avr, &h.uart, on_tx);
     int pty = argc > 2 && !strcmp(argv[2], "--pty");
     h.events = pty ? stderr : stdout;
     if (!pty)
-        h.avr->sleep = no_sleep;
+        h.avr->sleep = no_sleep; /* scripted mode runs as fast as it can */
     setvbuf(stdout, NULL, _IOFBF, 1 << 16);
     return pty ? real_time() : scripted();
 }

@@ -34,14 +34,12 @@
 #include <string.h>
 #include <sys/inotify.h>
 #include <termios.h>
-#include <time.h>
 #include <unistd.h>
 
-#include <simavr/avr_uart.h>
-#include <simavr/sim_avr.h>
 #include <simavr/sim_hex.h>
 
-#define F_CPU 16000000UL
+#include "common.h"
+
 #define BAUD 115200UL
 #define CYCLES_PER_BYTE (10UL * F_CPU / BAUD) /* the USB-serial adapter's line: 10 bits a byte */
 #define BOOT_BASE 0x7E00u                     /* 512-byte boot section: BOOTSZ = 11 on an Uno */
@@ -59,8 +57,8 @@
 
 static struct {
     avr_t *avr;
-    avr_irq_t *uart_in;
-    int xon, master, client; /* client: a program has the port open */
+    struct uart0 uart;
+    int master, client; /* client: a program has the port open */
     int inotify, opens, autoreset; /* opens: the port's open file descriptions */
     int halted;                    /* simavr stopped the CPU; the next reset restarts it */
     uint8_t queue[4096];     /* bytes from the port waiting for UART0: queue[head..tail) */
@@ -82,23 +80,6 @@ static void on_tx(struct avr_irq_t *irq, uint32_t value, void *param)
     (void)irq, (void)param;
     uint8_t byte = (uint8_t)value;
     if (u.client && write(u.master, &byte, 1) < 0) { /* full: lost, as on a wire */ }
-}
-
-static void on_xon(struct avr_irq_t *irq, uint32_t value, void *param)
-{
-    (void)irq, (void)value, (void)param;
-    u.xon = 1;
-}
-
-static void on_xoff(struct avr_irq_t *irq, uint32_t value, void *param)
-{
-    (void)irq, (void)value, (void)param;
-    u.xon = 0;
-}
-
-static void no_sleep(avr_t *avr, avr_cycle_count_t how_long)
-{
-    (void)avr, (void)how_long; /* the wall-clock throttle in run() does the waiting */
 }
 
 static int load_application(void)
@@ -185,17 +166,17 @@ static void reset(uint8_t mcusr)
     if (u.avr->cycle < before) /* simavr restarts its cycle count at a reset */
         u.elapsed += before;
     u.avr->data[REG_MCUSR] = mcusr;
-    u.xon = 0;
+    u.uart.xon = 0;
     u.next_in = 0;
     printf("reset %llu %02x\n", (unsigned long long)now(), mcusr);
 }
 
 static void feed_uart(void)
 {
-    if (u.head == u.tail || !u.xon || u.avr->cycle < u.next_in)
+    if (u.head == u.tail || !u.uart.xon || u.avr->cycle < u.next_in)
         return;
     u.next_in = u.avr->cycle + CYCLES_PER_BYTE;
-    avr_raise_irq(u.uart_in, u.queue[u.head++]);
+    avr_raise_irq(u.uart.in, u.queue[u.head++]);
 }
 
 static void watch_pins(void)
@@ -225,7 +206,7 @@ static void step(void)
         u.elapsed += before;
     /* at the reset vector, not by running on from erased flash below it: the watchdog reset it */
     if (u.avr->pc == u.avr->reset_pc && pc != u.avr->reset_pc && pc != u.avr->reset_pc - 2) {
-        u.xon = 0;
+        u.uart.xon = 0;
         u.next_in = 0;
         printf("reset %llu %02x\n", (unsigned long long)now(), u.avr->data[REG_MCUSR]);
         save_application(); /* optiboot leaves through a watchdog reset after programming */
@@ -282,13 +263,6 @@ static void serve_port(void)
     ssize_t n = read(u.master, u.queue + u.tail, sizeof u.queue - u.tail);
     if (n > 0)
         u.tail += (size_t)n;
-}
-
-static double wall(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return t.tv_sec + t.tv_nsec * 1e-9;
 }
 
 static int open_pty(void)
@@ -357,17 +331,9 @@ int main(int argc, char **argv)
     if (load_application() < 0 || (bootloader && load_bootloader(argv[1]) < 0))
         return 2;
     u.avr->reset_pc = bootloader ? BOOT_BASE : 0; /* BOOTRST programmed: enter the bootloader */
-    u.avr->sleep = no_sleep;
+    u.avr->sleep = no_sleep; /* the wall-clock throttle in run() does the waiting */
     u.last_a = u.last_b = u.last_dir = ~0u;
-    uint32_t flags = 0; /* no console echo, and no sleeping on each empty poll of RXC */
-    avr_ioctl(u.avr, AVR_IOCTL_UART_SET_FLAGS('0'), &flags);
-    u.uart_in = avr_io_getirq(u.avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_INPUT);
-    avr_irq_register_notify(avr_io_getirq(u.avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUTPUT),
-                            on_tx, NULL);
-    avr_irq_register_notify(avr_io_getirq(u.avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUT_XON),
-                            on_xon, NULL);
-    avr_irq_register_notify(avr_io_getirq(u.avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUT_XOFF),
-                            on_xoff, NULL);
+    uart0_wire(u.avr, &u.uart, on_tx);
     signal(SIGTERM, on_signal);
     signal(SIGINT, on_signal);
     signal(SIGPIPE, SIG_IGN);
