@@ -59,6 +59,17 @@ class Run:
         return state, self.visited[state]
 
 
+@dataclass(frozen=True)
+class Move:
+    """One step of a Q learner on one parameter: from state s, action a (0 shrink, 1 keep,
+    2 grow), the reward it earned and the state it reached."""
+
+    s: int
+    a: int
+    reward: float
+    s_next: int
+
+
 @dataclass
 class TuneResult:
     method: str
@@ -68,6 +79,7 @@ class TuneResult:
     visited: list[tuple[State, float]]  # distinct states in the order this run evaluated them
     history: list[tuple[State, float]]  # one entry per iteration: state visited, its bad %
     q_table: dict[State, np.ndarray] = field(default_factory=dict)
+    moves: list[Move] = field(default_factory=list)  # paper and guided: every step, in order
 
     @property
     def evaluations(self) -> int:
@@ -123,9 +135,11 @@ def _greedy(values: np.ndarray, epsilon: float, rng: np.random.Generator, keep: 
 
 
 def _result(method: str, space: Space, run: Run, history: list[tuple[State, float]],
-            q: dict[State, np.ndarray] | None = None) -> TuneResult:
+            q: dict[State, np.ndarray] | None = None, moves: list[Move] | None = None
+            ) -> TuneResult:
     best, best_bad = run.best()
-    return TuneResult(method, space, best, best_bad, list(run.visited.items()), history, q or {})
+    return TuneResult(method, space, best, best_bad, list(run.visited.items()), history, q or {},
+                      moves or [])
 
 
 def _one_dimension(space: Space, method: str) -> int:
@@ -144,6 +158,7 @@ def paper(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
     s = int(rng.integers(n))
     bad_s = obj((s,))
     history: list[tuple[State, float]] = []
+    moves: list[Move] = []
     for _ in range(iterations):
         if rng.random() < epsilon:
             a = int(rng.integers(3))
@@ -152,11 +167,12 @@ def paper(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
         s2 = min(max(s + (a - 1) * step, 0), n - 1)
         bad2 = obj((s2,))
         paper_update(q, s, a, bad_s - bad2, s2, gamma)
+        moves.append(Move(s, a, bad_s - bad2, s2))
         s, bad_s = s2, bad2
         history.append(((s2,), bad2))
         if on_step:
             on_step()
-    return _result("paper", space, obj, history, {(i,): q[i].copy() for i in range(n)})
+    return _result("paper", space, obj, history, {(i,): q[i].copy() for i in range(n)}, moves)
 
 
 def guided(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
@@ -168,6 +184,7 @@ def guided(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
     s = int(rng.integers(n))
     bad_s = obj((s,))
     history: list[tuple[State, float]] = []
+    moves: list[Move] = []
     prefer = None
     for _ in range(iterations):
         a = _greedy(q[s], epsilon, rng, keep=1, prefer=prefer)
@@ -175,12 +192,14 @@ def guided(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
         bad2 = obj((s2,))
         reward = bad_s - bad2
         paper_update(q, s, a, reward, s2, gamma)
+        moves.append(Move(s, a, reward, s2))
         prefer = a if reward > 0 else 2 - a  # repeat an improving move, else undo it
         s, bad_s = s2, bad2
         history.append(((s2,), bad2))
         if on_step:
             on_step()
-    return _result("guided", space, obj, history, {(i,): q[i].copy() for i in range(n)})
+    return _result("guided", space, obj, history, {(i,): q[i].copy() for i in range(n)},
+                   moves)
 
 
 def qlearning(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
