@@ -18,6 +18,8 @@ from rosbags.highlevel import AnyReader  # noqa: E402
 from host.sim.renderer import Renderer  # noqa: E402
 from host.sim.world import World  # noqa: E402
 
+from ..in_process import host  # noqa: E402
+
 
 def _pairs(folder: Path, frames: int = 3) -> None:
     renderer = Renderer(World())
@@ -83,10 +85,10 @@ def test_view_records_the_maps_it_showed(tmp_path: Path) -> None:
 def test_an_existing_recording_is_never_overwritten(tmp_path: Path) -> None:
     rec = tmp_path / "old.mcap"
     rec.write_bytes(b"the user's")
-    r = _host("servo", "--sim", "--record", str(rec))
+    r = host("servo", "--sim", "--record", str(rec))
     assert r.returncode == 2 and "exists already" in r.stderr
     assert r.stderr.count("\n") == 1 and rec.read_bytes() == b"the user's"
-    r = _host("servo", "--sim", "--record", str(tmp_path / "run.bag"))
+    r = host("servo", "--sim", "--record", str(tmp_path / "run.bag"))
     assert r.returncode == 2 and "name it .mcap" in r.stderr
 
 
@@ -97,7 +99,7 @@ def test_options_that_cannot_go_together_are_one_line(tmp_path: Path) -> None:
              "not with --trials"),
             (["--sim", "--view-wait"], "give --view too"),
             (["--camera", f"replay:{missing}", "--port", "emulator"], "no such recording")):
-        r = _host("servo", *args)
+        r = host("servo", *args)
         assert r.returncode == 2 and words in r.stderr, r.stderr
         assert r.stderr.count("\n") == 1
     assert not (tmp_path / "t.mcap").exists()

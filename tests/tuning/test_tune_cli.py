@@ -20,6 +20,8 @@ from host.tuning.learners import tune
 from host.tuning.objective import Objective, SceneTable
 from host.tuning.spaces import make_space, odd_range
 
+from ..in_process import host
+
 
 def gt_objective(scenes, space, workers: int = 1) -> Objective:
     ranges = [RangePolicy().resolve(s.left, s.right, gt=s.gt) for s in scenes]
@@ -82,13 +84,10 @@ def test_tuned_params_round_trip_into_eval(tmp_path: Path, capsys) -> None:
     assert row["matcher"]["block_size"] == load_params(out)[0].block_size
 
 
-def _run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str]:
+def _run(*argv: str) -> tuple[int, str]:
     """host tune in this process: (exit status, stderr)."""
-    try:
-        code = main(["tune", *argv])
-    except SystemExit as e:  # argparse's refusal
-        code = int(e.code or 0)
-    return code, capsys.readouterr().err
+    r = host("tune", *argv)
+    return r.returncode, r.stderr
 
 
 @pytest.mark.parametrize("argv, message", [
@@ -100,22 +99,22 @@ def _run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str]:
     (["--alpha", "0.5", "--method", "paper"], "belong to --method qlearning"),
     (["--method", "grid", "--gamma", "0.5"], "takes no learning parameters"),
 ])
-def test_bad_input_is_a_one_line_error(argv: list[str], message: str, capsys) -> None:
-    code, err = _run(capsys, *argv)
+def test_bad_input_is_a_one_line_error(argv: list[str], message: str) -> None:
+    code, err = _run(*argv)
     assert code == 2 and message in err and err.count("\n") == 1
 
 
-def test_a_scene_without_ground_truth_is_refused(tmp_path: Path, capsys) -> None:
+def test_a_scene_without_ground_truth_is_refused(tmp_path: Path) -> None:
     for name in ("im0.png", "im1.png"):
         cv2.imwrite(str(tmp_path / name), np.zeros((40, 80), np.uint8))
-    code, err = _run(capsys, str(tmp_path))
+    code, err = _run(str(tmp_path))
     assert code == 2 and "no ground truth" in err
 
 
-def test_an_interrupted_run_leaves_no_params_file(tmp_path: Path, capsys) -> None:
+def test_an_interrupted_run_leaves_no_params_file(tmp_path: Path) -> None:
     out = tmp_path / "p.toml"
     out.write_text("[matcher]\nblock_size = 7\n")
-    code, _ = _run(capsys, "--iterations", "0", "--out", str(out))
+    code, _ = _run("--iterations", "0", "--out", str(out))
     assert code == 2 and out.read_text() == "[matcher]\nblock_size = 7\n"
 
 

@@ -19,6 +19,8 @@ import numpy as np
 from host.sim.renderer import Renderer
 from host.sim.world import World
 
+from ..in_process import host
+
 
 def _recording(folder: Path, frames: int = 3) -> None:
     renderer = Renderer(World())
@@ -66,7 +68,6 @@ def test_view_shows_a_recording_without_stop(tmp_path: Path) -> None:
 
 
 def test_bad_view_address_is_one_line(tmp_path: Path) -> None:
-    r = subprocess.run([sys.executable, "-m", "host", "servo", "--sim", "--view", "here:there"],
-                       capture_output=True, text=True, timeout=120)
+    r = host("servo", "--sim", "--view", "here:there")
     assert r.returncode == 2 and "--view must be [HOST:]PORT" in r.stderr
     assert r.stderr.count("\n") == 1
