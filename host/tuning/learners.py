@@ -149,57 +149,54 @@ def _one_dimension(space: Space, method: str) -> int:
     return space.shape[0]
 
 
-def paper(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
-          gamma: float = 0.8, epsilon: float = 0.0, step: int = 1,
-          on_step: Callable[[], None] | None = None) -> TuneResult:
-    """The paper's learner as published: greedy on Q with random tie-breaks, equation 6."""
-    n = _one_dimension(space, "paper's")
+def _equation_6(method: str, obj: Run, space: Space, iterations: int, rng: np.random.Generator,
+                gamma: float, step: int, on_step: Callable[[], None] | None,
+                choose: Callable[[np.ndarray, Move | None], int]) -> TuneResult:
+    """The paper's loop on one parameter: Q from zeros, a random start state, then at each step
+    the action choose() takes from the state's Q row (and the last move), and equation 6."""
+    n = _one_dimension(space, "paper's" if method == "paper" else method)
     q = np.zeros((n, 3))  # actions: shrink, keep, grow
     s = int(rng.integers(n))
     bad_s = obj((s,))
     history: list[tuple[State, float]] = []
     moves: list[Move] = []
     for _ in range(iterations):
-        if rng.random() < epsilon:
-            a = int(rng.integers(3))
-        else:
-            a = int(rng.choice(np.flatnonzero(q[s] == q[s].max())))
+        a = choose(q[s], moves[-1] if moves else None)
         s2 = min(max(s + (a - 1) * step, 0), n - 1)
         bad2 = obj((s2,))
-        paper_update(q, s, a, bad_s - bad2, s2, gamma)
         moves.append(Move(s, a, bad_s - bad2, s2))
+        paper_update(q, s, a, bad_s - bad2, s2, gamma)
         s, bad_s = s2, bad2
         history.append(((s2,), bad2))
         if on_step:
             on_step()
-    return _result("paper", space, obj, history, {(i,): q[i].copy() for i in range(n)}, moves)
+    return _result(method, space, obj, history, {(i,): q[i].copy() for i in range(n)}, moves)
+
+
+def paper(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
+          gamma: float = 0.8, epsilon: float = 0.0, step: int = 1,
+          on_step: Callable[[], None] | None = None) -> TuneResult:
+    """The paper's learner as published: greedy on Q with random tie-breaks, equation 6."""
+
+    def choose(row: np.ndarray, last: Move | None) -> int:
+        if rng.random() < epsilon:
+            return int(rng.integers(3))
+        return int(rng.choice(np.flatnonzero(row == row.max())))
+
+    return _equation_6("paper", obj, space, iterations, rng, gamma, step, on_step, choose)
 
 
 def guided(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
            gamma: float = 0.8, epsilon: float = 0.2, step: int = 1,
            on_step: Callable[[], None] | None = None) -> TuneResult:
     """Equation 6 with the hill-climbing heuristics (see the module's docstring)."""
-    n = _one_dimension(space, "guided")
-    q = np.zeros((n, 3))  # actions: shrink, keep, grow
-    s = int(rng.integers(n))
-    bad_s = obj((s,))
-    history: list[tuple[State, float]] = []
-    moves: list[Move] = []
-    prefer = None
-    for _ in range(iterations):
-        a = _greedy(q[s], epsilon, rng, keep=1, prefer=prefer)
-        s2 = min(max(s + (a - 1) * step, 0), n - 1)
-        bad2 = obj((s2,))
-        reward = bad_s - bad2
-        paper_update(q, s, a, reward, s2, gamma)
-        moves.append(Move(s, a, reward, s2))
-        prefer = a if reward > 0 else 2 - a  # repeat an improving move, else undo it
-        s, bad_s = s2, bad2
-        history.append(((s2,), bad2))
-        if on_step:
-            on_step()
-    return _result("guided", space, obj, history, {(i,): q[i].copy() for i in range(n)},
-                   moves)
+
+    def choose(row: np.ndarray, last: Move | None) -> int:
+        # repeat an improving move, else undo it
+        prefer = None if last is None else last.a if last.reward > 0 else 2 - last.a
+        return _greedy(row, epsilon, rng, keep=1, prefer=prefer)
+
+    return _equation_6("guided", obj, space, iterations, rng, gamma, step, on_step, choose)
 
 
 def qlearning(obj: Run, space: Space, iterations: int, rng: np.random.Generator,

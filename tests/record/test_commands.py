@@ -21,13 +21,17 @@ from host.sim.world import World  # noqa: E402
 from ..in_process import host  # noqa: E402
 
 
-def _pairs(folder: Path, frames: int = 3) -> None:
+@pytest.fixture(scope="module")
+def src(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Three rendered pairs, the robot nearer in each, as a folder for --camera replay:."""
+    folder = tmp_path_factory.mktemp("src")
     renderer = Renderer(World())
-    for i in range(frames):
+    for i in range(3):
         renderer.world.robot.z_m -= 0.05  # each pair its own
         pair = renderer.frame(with_robot=True)
         cv2.imwrite(str(folder / f"left_{i:03d}.png"), pair.left)
         cv2.imwrite(str(folder / f"right_{i:03d}.png"), pair.right)
+    return folder
 
 
 def _read(path: Path) -> dict[str, list]:
@@ -49,10 +53,7 @@ def _image(msg) -> np.ndarray:
         msg.height, msg.width, -1).squeeze()
 
 
-def test_capture_records_every_pair(tmp_path: Path) -> None:
-    src = tmp_path / "src"
-    src.mkdir()
-    _pairs(src)
+def test_capture_records_every_pair(src: Path, tmp_path: Path) -> None:
     rec = tmp_path / "capture.mcap"
     r = _host("capture", "--camera", f"replay:{src}", "--count", "3", "--interval", "0",
               "--out", str(tmp_path / "out"), "--record", str(rec))
@@ -65,10 +66,7 @@ def test_capture_records_every_pair(tmp_path: Path) -> None:
     assert "/stereo/disparity" not in topics  # capture computes none
 
 
-def test_view_records_the_maps_it_showed(tmp_path: Path) -> None:
-    src = tmp_path / "src"
-    src.mkdir()
-    _pairs(src)
+def test_view_records_the_maps_it_showed(src: Path, tmp_path: Path) -> None:
     rec = tmp_path / "view.mcap"
     r = _host("view", "--camera", f"replay:{src}", "--border", "clip", "--num-disp", "48",
               "--duration", "4", "--record", str(rec))
