@@ -144,7 +144,7 @@ def _check_args(args: argparse.Namespace) -> int:
     return iterations
 
 
-def _camera_scenes(args: argparse.Namespace) -> tuple[list[Scene], float | None]:
+def camera_scenes(args: argparse.Namespace) -> tuple[list[Scene], float | None]:
     """Pairs from --camera as scenes without ground truth, and focal_px * baseline_m when the
     geometry is known (calibration or simulation). The right view is brought to the left's
     exposure as `host servo` does before it matches, so the tuned parameters fit what the servo
@@ -221,7 +221,7 @@ class TuneJob:
             raise HostError("a camera's frames have no ground truth: use --objective self")
         focal_baseline = None
         if args.camera is not None:
-            scenes, focal_baseline = _camera_scenes(args)
+            scenes, focal_baseline = camera_scenes(args)
         else:
             scenes = load_scenes(args.scenes, args.scale)
         for s in scenes:
