@@ -42,7 +42,7 @@ demo: venv
 	@echo "pictures: $(OUT)/motorcycle.png (disparity), $(OUT)/tuning.png (tuning), $(OUT)/servo.png (servo run)"
 
 test: venv system-deps browser-deps platformio lint typecheck
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest --durations=20
 
 lint: venv
 	$(BIN)/ruff check host tools bench tests

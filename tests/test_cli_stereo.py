@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import subprocess
-import sys
 from pathlib import Path
 
 import cv2
@@ -16,9 +15,11 @@ from host.stereo import MatcherParams, compute_disparity, evaluate, load_scene
 from host.stereo.metrics import round_submission
 from host.stereo.synthetic import synthetic_scene
 
+from .in_process import host
+
 
 def run(*argv: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "host", *argv], capture_output=True, text=True)
+    return host(*argv)  # in this process: no Python start-up per call
 
 
 @pytest.fixture()

@@ -5,26 +5,17 @@ from __future__ import annotations
 
 import asyncio
 import json
-import re
-import subprocess
-import sys
 
 import aiohttp
 import pytest
 
 from host.cli import main
 
+from .view.running import host_view
+
 
 def test_view_shows_the_simulated_world() -> None:
-    proc = subprocess.Popen([sys.executable, "-m", "host", "view", "--camera", "sim",
-                             "--duration", "60"], stderr=subprocess.PIPE, text=True)
-    try:
-        line = ""
-        while not line.startswith("live view: "):
-            line = proc.stderr.readline()  # type: ignore[union-attr]
-            assert line, "host view ended without printing its address"
-        url = re.search(r"http://(\S+)/", line)[1]  # type: ignore[index]
-
+    with host_view("--camera", "sim", "--duration", "60") as url:
         async def updates(n: int) -> list[dict]:
             """Up to n states, until one shows the robot's marker."""
             states: list[dict] = []
@@ -41,9 +32,6 @@ def test_view_shows_the_simulated_world() -> None:
         # the first frames without the robot, as the servo's reference phase sees them; then
         # the simulated robot at its start
         assert states[-1]["overlay"]["marker"] is not None, len(states)
-    finally:
-        proc.terminate()
-        proc.wait(timeout=10)
 
 
 def test_view_sim_refuses_a_calibration(tmp_path, capsys: pytest.CaptureFixture[str]) -> None:

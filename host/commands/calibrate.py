@@ -8,7 +8,7 @@ from pathlib import Path
 
 from host.camera.calib_files import save_ros
 from host.camera.calib_report import check_picture, coverage, coverage_lines
-from host.camera.calibration import MIN_VIEWS, calibrate
+from host.camera.calibration import MIN_VIEWS, CalibrationRun, View, calibrate
 from host.camera.replay import image_pairs
 from host.camera.source import StereoFrame
 from host.commands.options import COUNT, POSITIVE
@@ -64,7 +64,8 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _report(result, n_pairs, used, written) -> None:
+def _report(result: CalibrationRun, n_pairs: int, used: list[View], written: list[str]
+            ) -> None:
     calib, g = result.calibration, result.calibration.geometry
     print(f"{', '.join(written)}: {len(used)} of {n_pairs} pairs used, "
           f"{calib.size[0]}x{calib.size[1]}")
@@ -81,5 +82,5 @@ def _report(result, n_pairs, used, written) -> None:
           f"{calib.epipolar_rms:.3f} px RMS")
     print(f"  rectified focal length {g.focal_px:.1f} px, baseline {calib.baseline_mm:.1f} mm")
     for side, k in (("left", 0), ("right", 1)):
-        counts = coverage([v.corners[k] for v in used], calib.size)
+        counts = coverage([v.corners[k] for v in used if v.corners is not None], calib.size)
         print("\n".join(coverage_lines(counts, side)))

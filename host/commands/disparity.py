@@ -29,7 +29,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p.set_defaults(run=run)
 
 
-def _eight_bit(path, img: np.ndarray) -> np.ndarray:
+def _eight_bit(path: Path, img: np.ndarray) -> np.ndarray:
     """The image as the matchers take it (8-bit grey or BGR, alpha dropped), or one line."""
     if img.dtype != np.uint8:
         raise HostError(f"{path}: a {8 * img.itemsize}-bit image: the matchers take 8-bit "

@@ -6,11 +6,15 @@ import argparse
 import sys
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from host.commands.options import NON_NEGATIVE, POSITIVE, SEED, float_range
 from host.emulator.emulator import Emulator, Faults, PtyService
 from host.errors import HostError
 from host.files import check_folder
+
+if TYPE_CHECKING:
+    from host.emulator.uno import Reset
 
 FLASH_DEFAULT = Path("uno-flash.bin")
 RESET_LINES_PER_S = 3  # an erased chip resets ~60 times a second: say so once, not 60 times
@@ -128,7 +132,7 @@ class _ResetLines:
     def __init__(self) -> None:
         self.window, self.shown, self.said = 0.0, 0, False
 
-    def add(self, r, now: float) -> None:
+    def add(self, r: Reset, now: float) -> None:
         if now - self.window >= 1.0:
             self.window, self.shown = now, 0
         self.shown += 1

@@ -9,8 +9,11 @@ import math
 import re
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
+from host.camera.geometry import Geometry
 from host.camera.open import add_camera_options, open_source, parse_size, source_geometry
 from host.commands.options import (
     COUNT,
@@ -31,10 +34,16 @@ from host.files import check_folder, check_output
 from host.link.client import SERVO_DRIVE_BUDGET_S, RobotLink
 from host.record import add_record_options, check_record, record_servo
 from host.servo.controller import ControlConfig
-from host.servo.loop import Servo
+from host.servo.loop import LogRow, Servo
 from host.servo.report import plot_run, write_csv
 from host.servo_run import ENDED, NOT_SETTLED, Rules, run_servo
 from host.signals import signals_held
+
+if TYPE_CHECKING:
+    from host.emulator.emulator import Faults
+    from host.emulator.simavr import SimavrPty
+    from host.emulator.uno import SimulatedUno
+    from host.sim.world import World
 
 UNO_FLASH = Path("uno-flash.bin")  # --robot uno's flash file when --flash is not given
 
@@ -122,7 +131,7 @@ class _Status:
         self.tty = sys.stderr.isatty()
         self._last = 0.0
 
-    def show(self, row) -> None:
+    def show(self, row: LogRow) -> None:
         now = time.monotonic()
         if not self.tty or now - self._last < 0.1:
             return
@@ -190,7 +199,7 @@ def run(args: argparse.Namespace) -> int:
         return _servo(args, servo, geometry, None, clock)
 
 
-def _check_trial_args(args) -> None:
+def _check_trial_args(args: argparse.Namespace) -> None:
     if args.json:
         if args.json.is_dir():
             raise HostError(f"--json {args.json}: is a folder (name a file)")
@@ -206,19 +215,19 @@ def _check_trial_args(args) -> None:
                         f"{args.ray!r}")
 
 
-def _link_faults(args):
+def _link_faults(args: argparse.Namespace) -> Faults:
     from host.emulator.emulator import Faults
 
     return Faults(drop=args.drop, corrupt=args.corrupt, delay_ms=args.delay_ms,
                   silent_after_ms=args.silent_after, seed=args.seed)
 
 
-def _control(args) -> ControlConfig:
+def _control(args: argparse.Namespace) -> ControlConfig:
     return ControlConfig(tolerance_m=args.tolerance_cm / 100, max_duty=args.max_duty,
                          min_duty=args.min_duty, mode=args.mode)
 
 
-def _run_sim(args) -> int:
+def _run_sim(args: argparse.Namespace) -> int:
     import dataclasses
 
     import numpy as np
@@ -253,7 +262,7 @@ def _run_sim(args) -> int:
         return _servo(args, sim.servo, sim.servo.geometry, sim.world, sim.source.clock)
 
 
-def _avr_board(args):
+def _avr_board(args: argparse.Namespace) -> SimulatedUno | SimavrPty:
     """The real AVR firmware on a simulated board, for the simulated world to drive."""
     from host.emulator import build
 
@@ -272,33 +281,35 @@ def _avr_board(args):
     return SimavrPty(build.simavr_harness(out), build.firmware_elf())
 
 
-def _servo(args, servo, geometry, world, clock) -> int:
+def _servo(args: argparse.Namespace, servo: Servo, geometry: Geometry, world: World | None,
+           clock: Callable[[], float]) -> int:
     with open_view(args.view, servo, args.view_wait) as view:
         # a simulated run's page stays up after the run has ended (not when its STOP ended it)
-        hold = view is not None and world is not None
+        hold = view if world is not None else None
         try:
             with record_servo(args, servo, clock):
                 status = _run_servo(args, servo, geometry, world, clock)
         except NotReached as e:
-            if hold and not servo.requested_stop:
-                hold_view(view, str(e))
+            if hold is not None and not servo.requested_stop:
+                hold_view(hold, str(e))
             raise
-        if hold and not servo.requested_stop:
-            hold_view(view, outcome(servo)[1])
+        if hold is not None and not servo.requested_stop:
+            hold_view(hold, outcome(servo)[1])
         return status
 
 
 SIM_LIMIT_S = 60.0  # a simulated run without --duration that has not settled by then failed
 
 
-def _run_servo(args, servo, geometry, world, clock) -> int:
+def _run_servo(args: argparse.Namespace, servo: Servo, geometry: Geometry,
+               world: World | None, clock: Callable[[], float]) -> int:
     target = servo.reference()
     z = geometry.depth_m(target.disparity)
     print(f"target: nearest object at disparity {target.disparity:.2f} px ({z:.3f} m), "
           f"{target.area} px; tolerance {servo.tolerance_m * 100:g} cm", file=sys.stderr)
     status = _Status()
 
-    def each(row) -> None:
+    def each(row: LogRow) -> None:
         for note in servo.notes + servo.link.notes:
             print(f"note: {note}", file=sys.stderr)
         servo.notes.clear()

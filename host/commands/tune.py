@@ -8,6 +8,7 @@ import datetime
 import json
 import re
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -26,6 +27,7 @@ from host.commands.swap_check import check_pairs
 from host.errors import HostError
 from host.files import all_or_nothing, check_output
 from host.params_file import save_params
+from host.stereo import MatcherParams
 from host.stereo.scenes import Scene, load_scenes
 from host.tuning.backends import make_backend
 from host.tuning.disparity_range import RangePolicy
@@ -142,7 +144,7 @@ def _check_args(args: argparse.Namespace) -> int:
     return iterations
 
 
-def _camera_scenes(args: argparse.Namespace) -> tuple[list[Scene], float | None]:
+def camera_scenes(args: argparse.Namespace) -> tuple[list[Scene], float | None]:
     """Pairs from --camera as scenes without ground truth, and focal_px * baseline_m when the
     geometry is known (calibration or simulation). The right view is brought to the left's
     exposure as `host servo` does before it matches, so the tuned parameters fit what the servo
@@ -179,121 +181,184 @@ def _validate_space(space: Space, scenes: list[Scene], ranges: list[tuple[int, i
             apply_range(p, r).validate(width=sc.left.shape[1])
 
 
-def _run_method(args: argparse.Namespace, obj: Objective, space: Space, iterations: int,
-                hyper: dict[str, Any], show: bool, what: str) -> TuneResult:
-    total = space.size if args.method == "grid" else iterations
-    bar = _progress(total, show, what)
+@dataclass(frozen=True)
+class TuneJob:
+    """What `host tune` was asked to do, checked: the scenes with their disparity ranges, the
+    space, the learner and its settings, and where the results go. from_args raises HostError
+    (one line, exit 2) on bad input before anything runs or is written."""
+
+    method: str
+    space: Space
+    seed: int
+    objective: str  # "gt": bad % against ground truth; "self": the self-supervised score
+    iterations: int
+    hyper: dict[str, Any]
+    scenes: list[Scene]
+    n_tune: int  # tune on scenes[:n_tune], report the others as held out
+    cv: bool  # leave-one-scene-out folds first
+    policy: RangePolicy
+    ranges: list[tuple[int, int]]  # each scene's, from the policy
+    workers: int
+    ray: str | None
+    out: Path | None
+    plot: Path | None
+    json: bool
+    progress: bool  # a progress bar on stderr
+
+    @classmethod
+    def from_args(cls, args: argparse.Namespace) -> TuneJob:
+        if args.out:
+            check_output(args.out, "toml", "--out")
+        if args.plot:
+            check_output(args.plot, "png", "--plot")
+        iterations = _check_args(args)
+        hyper = _hyper(args)
+        if args.params is None and args.border is None:
+            args = argparse.Namespace(**vars(args) | {"border": TUNE_BORDER})
+        if args.camera is not None and args.scenes:
+            raise HostError("give scene folders or --camera, not both")
+        if args.camera is not None and args.objective != "self":
+            raise HostError("a camera's frames have no ground truth: use --objective self")
+        focal_baseline = None
+        if args.camera is not None:
+            scenes, focal_baseline = camera_scenes(args)
+        else:
+            scenes = load_scenes(args.scenes, args.scale)
+        for s in scenes:
+            if s.gt is None and args.objective == "gt":
+                raise HostError(f"{s.name}: no ground truth to tune against "
+                                "(--objective self needs none)")
+        if args.objective == "self":
+            check_pairs([(s.name, s.left, s.right) for s in scenes], args.swap_check)
+        n_tune = len(scenes) if args.tune_on is None else args.tune_on
+        if not 1 <= n_tune <= len(scenes):
+            raise HostError(f"--tune-on must be 1..{len(scenes)}, got {args.tune_on}")
+        if args.cv and len(scenes) < 2:
+            raise HostError("--cv needs at least two scenes")
+        default_policy = "ground-truth" if args.objective == "gt" else "coarse"
+        policy = RangePolicy.parse(args.range_policy or default_policy, args.range_margin)
+        if args.objective == "self" and policy.kind == "ground-truth":
+            raise HostError("the self-supervised objective uses no ground truth: choose --range "
+                            "coarse, depth:NEAR:FAR or fixed:N")
+        ranges = _ranges(scenes, policy, focal_baseline)
+        space = make_space(args.space, params_from_args(args), odd_range(args.windows))
+        if args.method in ("paper", "guided") and len(space.dims) != 1:
+            raise HostError(f"the {args.method} learner tunes one parameter; space {space.name} "
+                            f"has {len(space.dims)} (use --method qlearning)")
+        _validate_space(space, scenes, ranges)
+        return cls(args.method, space, args.seed, args.objective, iterations, hyper, scenes,
+                   n_tune, args.cv, policy, ranges, args.workers, args.ray, args.out, args.plot,
+                   args.json, progress=not args.json and sys.stderr.isatty())
+
+    @property
+    def tuned_on(self) -> list[Scene]:
+        return self.scenes[:self.n_tune]
+
+
+@dataclass(frozen=True)
+class TuneOutcome:
+    """What a tuning job found: the learner's result on the tuned-on scenes, the tuned
+    parameters' score on each scene, and the leave-one-out folds and ground-truth scores when
+    asked for or known."""
+
+    result: TuneResult
+    best: MatcherParams
+    held_out: dict[str, float]  # scene name: score with the tuned parameters
+    folds: dict[str, dict[str, Any]]  # --cv: left-out scene: its params, score, tuned score
+    truth: dict[str, float] | None  # self-tuned parameters against unused ground truth
+
+
+def run_job(job: TuneJob) -> TuneOutcome:
+    """Tune: no file is written and nothing printed (a progress bar on stderr if asked)."""
+    score = (GroundTruthScore(job.scenes, job.ranges) if job.objective == "gt"
+             else SelfSupervisedScore([(s.left, s.right) for s in job.scenes], job.ranges))
+    table = SceneTable(make_backend(score, job.workers, job.ray), job.space.params)
     try:
-        return tune(args.method, obj, space, iterations, args.seed,
-                    on_step=bar.update if bar else None, **hyper)
+        folds = {}
+        if job.cv:
+            for i, held in enumerate(job.scenes):
+                others = [j for j in range(len(job.scenes)) if j != i]
+                r = _run_method(job, Objective.of(table, others), f"without {held.name}")
+                folds[held.name] = {"params": job.space.values(r.best_state),
+                                    "bad": table.get([r.best_state])[0][i],
+                                    "tuned_bad": r.best_bad}
+        result = _run_method(job, Objective.of(table, list(range(job.n_tune))),
+                             f"{job.method} on {job.space.name}")
+        row = table.get([result.best_state])[0]
+    finally:
+        table.close()
+    best = job.space.params(result.best_state)
+    held_out = {s.name: row[i] for i, s in enumerate(job.scenes) if i >= job.n_tune}
+    truth = None
+    if job.objective == "self" and all(s.gt is not None for s in job.scenes):
+        # the self-tuned parameters scored against the ground truth it did not use
+        truth = dict(zip([s.name for s in job.scenes],
+                         GroundTruthScore(job.scenes, job.ranges)(best)))
+    return TuneOutcome(result, best, held_out, folds, truth)
+
+
+def _run_method(job: TuneJob, obj: Objective, what: str) -> TuneResult:
+    total = job.space.size if job.method == "grid" else job.iterations
+    bar = _progress(total, job.progress, what)
+    try:
+        return tune(job.method, obj, job.space, job.iterations, job.seed,
+                    on_step=bar.update if bar else None, **job.hyper)
     finally:
         if bar:
             bar.close()
 
 
-def run(args: argparse.Namespace) -> int:
-    if args.out:
-        check_output(args.out, "toml", "--out")
-    if args.plot:
-        check_output(args.plot, "png", "--plot")
-    iterations = _check_args(args)
-    hyper = _hyper(args)
-    if args.params is None and args.border is None:
-        args.border = TUNE_BORDER
-    if args.camera is not None and args.scenes:
-        raise HostError("give scene folders or --camera, not both")
-    if args.camera is not None and args.objective != "self":
-        raise HostError("a camera's frames have no ground truth: use --objective self")
-    focal_baseline = None
-    if args.camera is not None:
-        scenes, focal_baseline = _camera_scenes(args)
-    else:
-        scenes = load_scenes(args.scenes, args.scale)
-    for s in scenes:
-        if s.gt is None and args.objective == "gt":
-            raise HostError(f"{s.name}: no ground truth to tune against "
-                            "(--objective self needs none)")
-    if args.objective == "self":
-        check_pairs([(s.name, s.left, s.right) for s in scenes], args.swap_check)
-    n_tune = len(scenes) if args.tune_on is None else args.tune_on
-    if not 1 <= n_tune <= len(scenes):
-        raise HostError(f"--tune-on must be 1..{len(scenes)}, got {args.tune_on}")
-    if args.cv and len(scenes) < 2:
-        raise HostError("--cv needs at least two scenes")
-    default_policy = "ground-truth" if args.objective == "gt" else "coarse"
-    policy = RangePolicy.parse(args.range_policy or default_policy, args.range_margin)
-    if args.objective == "self" and policy.kind == "ground-truth":
-        raise HostError("the self-supervised objective uses no ground truth: choose --range "
-                        "coarse, depth:NEAR:FAR or fixed:N")
-    ranges = _ranges(scenes, policy, focal_baseline)
-    space = make_space(args.space, params_from_args(args), odd_range(args.windows))
-    if args.method in ("paper", "guided") and len(space.dims) != 1:
-        raise HostError(f"the {args.method} learner tunes one parameter; space {space.name} has "
-                        f"{len(space.dims)} (use --method qlearning)")
-    _validate_space(space, scenes, ranges)
-    score = (GroundTruthScore(scenes, ranges) if args.objective == "gt"
-             else SelfSupervisedScore([(s.left, s.right) for s in scenes], ranges))
-    show = not args.json and sys.stderr.isatty()
-    table = SceneTable(make_backend(score, args.workers, args.ray), space.params)
-    try:
-        folds = {}
-        if args.cv:
-            for i, held in enumerate(scenes):
-                others = [j for j in range(len(scenes)) if j != i]
-                r = _run_method(args, Objective.of(table, others), space, iterations, hyper,
-                                show, f"without {held.name}")
-                folds[held.name] = {"params": space.values(r.best_state),
-                                    "bad": table.get([r.best_state])[0][i],
-                                    "tuned_bad": r.best_bad}
-        result = _run_method(args, Objective.of(table, list(range(n_tune))), space,
-                             iterations, hyper, show, f"{args.method} on {args.space}")
-        row = table.get([result.best_state])[0]
-    finally:
-        table.close()
-    best = space.params(result.best_state)
-    tuned_on = scenes[:n_tune]
-    held_out = {s.name: row[i] for i, s in enumerate(scenes) if i >= n_tune}
-    truth = None
-    if args.objective == "self" and all(s.gt is not None for s in scenes):
-        # the self-tuned parameters scored against the ground truth it did not use
-        truth = dict(zip([s.name for s in scenes], GroundTruthScore(scenes, ranges)(best)))
+def to_json(job: TuneJob, done: TuneOutcome) -> dict[str, Any]:
+    """The --json object: the learner's result and what it was tuned and scored on."""
+    out = done.result.to_json() | {
+        "objective": job.objective, "scenes": [s.name for s in job.tuned_on],
+        "held_out": done.held_out, "disparity_range": str(job.policy),
+        "ranges": {s.name: list(r) for s, r in zip(job.scenes, job.ranges)}}
+    if job.cv:
+        out["leave_one_out"] = done.folds
+    if done.truth is not None:
+        out["ground_truth_bad"] = done.truth
+    return out
+
+
+def report(job: TuneJob, done: TuneOutcome) -> None:
+    """Write the parameters and the plot (both, or neither), then print the JSON object or
+    the lines."""
+    result = done.result
     with all_or_nothing():  # both outputs, or neither
-        if args.out:
-            save_params(args.out, best, {
-                "method": args.method, "space": args.space, "seed": args.seed,
-                "objective": {"gt": "ground-truth", "self": "self-supervised"}[args.objective],
-                "scenes": [s.name for s in tuned_on],
-                "bad" if args.objective == "gt" else "score": round(result.best_bad, 4),
+        if job.out:
+            save_params(job.out, done.best, {
+                "method": job.method, "space": job.space.name, "seed": job.seed,
+                "objective": {"gt": "ground-truth", "self": "self-supervised"}[job.objective],
+                "scenes": [s.name for s in job.tuned_on],
+                "bad" if job.objective == "gt" else "score": round(result.best_bad, 4),
                 "evaluations": result.evaluations,
                 "date": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")},
-                disparity_range=policy.to_table())
-        if args.plot:
+                disparity_range=job.policy.to_table())
+        if job.plot:
             from host.tuning.plot import plot
 
-            plot(result, args.plot, score="bad pixels (%)" if args.objective == "gt"
-                 else "self-supervised score (%)", scenes=tuple(s.name for s in tuned_on))
-    out = result.to_json() | {"objective": args.objective,
-                              "scenes": [s.name for s in tuned_on], "held_out": held_out,
-                              "disparity_range": str(policy),
-                              "ranges": {s.name: list(r) for s, r in zip(scenes, ranges)}}
-    if args.cv:
-        out["leave_one_out"] = folds
-    if truth is not None:
-        out["ground_truth_bad"] = truth
-    if args.json:
+            plot(result, job.plot, score="bad pixels (%)" if job.objective == "gt"
+                 else "self-supervised score (%)", scenes=tuple(s.name for s in job.tuned_on))
+    out = to_json(job, done)
+    if job.json:
         print(json.dumps(out, default=str))
-        return 0
-    what = "bad" if args.objective == "gt" else "self-supervised score"
-    print(f"{args.method} on {args.space} over {', '.join(out['scenes'])}: best "
+        return
+    what = "bad" if job.objective == "gt" else "self-supervised score"
+    print(f"{job.method} on {job.space.name} over {', '.join(out['scenes'])}: best "
           f"{result.best_bad:.2f}% {what} with {out['best_params']} after "
           f"{len(result.history)} iterations, {result.evaluations} distinct evaluations")
-    for name, bad in (truth or {}).items():
+    for name, bad in (done.truth or {}).items():
         print(f"  {name}: {bad:.2f}% bad against its ground truth (not used for tuning)")
-    for name, bad in held_out.items():
+    for name, bad in done.held_out.items():
         print(f"  held out {name}: {bad:.2f}% {what} with the tuned parameters")
-    for name, f in folds.items():
+    for name, f in done.folds.items():
         print(f"  left out {name}: {f['bad']:.2f}% {what} with {f['params']} "
               f"(tuned on the others: {f['tuned_bad']:.2f}%)")
-    if args.out:
-        print(f"  parameters written to {args.out} (disparity range: {policy})")
+    if job.out:
+        print(f"  parameters written to {job.out} (disparity range: {job.policy})")
+
+
+def run(args: argparse.Namespace) -> int:
+    report(job := TuneJob.from_args(args), run_job(job))
     return 0

@@ -8,9 +8,12 @@ import contextlib
 import dataclasses
 import sys
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
+from typing import TYPE_CHECKING
 
+from host.camera.geometry import Geometry
 from host.camera.open import add_camera_options, open_source, parse_size, source_geometry
+from host.camera.source import StereoSource
 from host.commands.options import POSITIVE, add_matcher_options, params_from_args
 from host.commands.swap_check import check_recorded
 from host.errors import HostError
@@ -18,6 +21,10 @@ from host.record import add_record_options, check_record, recording
 from host.servo.marker import find_marker
 from host.servo.snapshot import Snapshot
 from host.stereo.matcher import compute_disparity
+
+if TYPE_CHECKING:  # the web stack is optional (stereo-servo[view])
+    from host.servo.loop import Servo
+    from host.view import ViewServer
 
 
 def add_view_option(p: argparse.ArgumentParser, default: str | None = None,
@@ -32,7 +39,7 @@ def add_view_option(p: argparse.ArgumentParser, default: str | None = None,
                    help="--view: start only once a page is open (so none of the run is missed)")
 
 
-def wait_for_page(server, poll_s: float = 0.05) -> None:
+def wait_for_page(server: ViewServer, poll_s: float = 0.05) -> None:
     """Until a page has connected to server (Ctrl-C ends the wait, and the command)."""
     print("live view: waiting for a page to open (--view-wait; Ctrl-C to quit)",
           file=sys.stderr, flush=True)
@@ -40,7 +47,7 @@ def wait_for_page(server, poll_s: float = 0.05) -> None:
         time.sleep(poll_s)
 
 
-def hold_view(server, reason: str) -> None:
+def hold_view(server: ViewServer, reason: str) -> None:
     """After the run: the page says it has ended (reason) and stays up until Ctrl-C, which
     then ends the command as the run did (not as an interrupt)."""
     try:  # from before the line is printed: a Ctrl-C as soon as it is seen ends the wait
@@ -54,7 +61,8 @@ def hold_view(server, reason: str) -> None:
 
 
 @contextlib.contextmanager
-def open_view(address: str | None, servo=None, wait: bool = False) -> Iterator[object | None]:
+def open_view(address: str | None, servo: Servo | None = None, wait: bool = False
+              ) -> Iterator[ViewServer | None]:
     """The live view on address ([HOST:]PORT), fed by servo's steps, its STOP button stopping
     servo (no servo: no STOP); nothing when address is None. Prints the page's address; with
     wait, returns once a page has connected."""
@@ -95,7 +103,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 
 
 @contextlib.contextmanager
-def _sim(args: argparse.Namespace) -> Iterator[tuple[object, object]]:
+def _sim(args: argparse.Namespace) -> Iterator[tuple[StereoSource, Geometry]]:
     """--camera sim: the simulated world's camera (the robot standing at its start) at --speed
     times real time (default 1, 0 as fast as it goes), and its geometry."""
     from host.camera.paced import PacedSource
@@ -119,7 +127,8 @@ def run(args: argparse.Namespace) -> int:
             source = check_recorded(args, stack.enter_context(open_source(args)))
             geometry = source_geometry(args, source)
         view = stack.enter_context(open_view(args.view, wait=args.view_wait))
-        observers = [view.feed]
+        assert view is not None  # host view always serves the page (--view has a default)
+        observers: list[Callable[[Snapshot], None]] = [view.feed]
         rec = stack.enter_context(recording(args, time.monotonic))
         if rec is not None:
             from host.record.tap import RecordingSource, StepRecorder, map_range

@@ -57,9 +57,9 @@ def board_pairs(world: World, camera: CameraFaults, n: int = 24, seed: int = 0
             img = cv2.warpPerspective(tex, hom, (w, h), flags=cv2.INTER_AREA,
                                       borderValue=128).astype(np.float32)
             if lens is not None:
-                img = cv2.remap(img, lens[0], lens[1], cv2.INTER_LINEAR,
-                                borderMode=cv2.BORDER_REPLICATE)
-            img += rng.normal(0, 2.0, img.shape).astype(np.float32)
+                img = np.asarray(cv2.remap(img, lens[0], lens[1], cv2.INTER_LINEAR,
+                                           borderMode=cv2.BORDER_REPLICATE), np.float32)
+            img += rng.normal(0, 2.0, (h, w)).astype(np.float32)
             views.append(np.clip(np.rint(img), 0, 255).astype(np.uint8))
         pairs.append(StereoFrame(views[0], views[1], 0.0, 0.0))
     return pairs

@@ -23,14 +23,15 @@ def opencv_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> n
     if not colour:
         left, right = to_grey(left), to_grey(right)
     lr = -1 if p.lr_check is None else max(1, int(round(p.lr_check)))
+    m: cv2.StereoBM | cv2.StereoSGBM
     if p.matcher == "opencv-bm":
-        m = cv2.StereoBM_create(p.num_disparities, p.block_size)
+        m = cv2.StereoBM.create(p.num_disparities, p.block_size)
         m.setPreFilterCap(max(1, min(63, p.pre_filter_cap)))
         m.setTextureThreshold(p.texture_threshold)
     else:
         cn = 3 if colour else 1
         area = cn * p.block_size * p.block_size
-        m = cv2.StereoSGBM_create(
+        m = cv2.StereoSGBM.create(
             minDisparity=p.min_disparity,
             numDisparities=p.num_disparities,
             blockSize=p.block_size,

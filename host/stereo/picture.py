@@ -20,7 +20,7 @@ def colourise(disp: np.ndarray, max_disparity: float | None = None) -> np.ndarra
     scaled = np.clip(np.nan_to_num(disp) / max(top, 1e-6) * 255.0, 0, 255).astype(np.uint8)
     pic = cv2.applyColorMap(scaled, cv2.COLORMAP_TURBO)
     pic[~valid] = 0
-    return pic
+    return np.asarray(pic)
 
 
 @dataclass(frozen=True)

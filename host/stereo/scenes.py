@@ -8,8 +8,10 @@ from __future__ import annotations
 
 import json
 import os
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import cast
 
 import cv2
 import numpy as np
@@ -63,7 +65,7 @@ def _gt_png(path: Path, scale: float) -> np.ndarray:
 
 def _mask(path: Path, value: int = 255) -> np.ndarray:
     raw = read_image(path, cv2.IMREAD_GRAYSCALE)
-    return raw == value
+    return np.asarray(raw == value)
 
 
 def _check_sizes(name: str, scene: Scene) -> Scene:
@@ -189,7 +191,10 @@ def default_scene() -> Scene:
     """Middlebury 2014 Motorcycle (quarter size), shipped inside scikit-image's wheel."""
     from skimage import data
 
-    left, right, gt = data.stereo_motorcycle()
+    # scikit-image leaves it unannotated: three arrays, the views (RGB) and the disparity
+    motorcycle = cast(Callable[[], tuple[np.ndarray, np.ndarray, np.ndarray]],
+                      data.stereo_motorcycle)
+    left, right, gt = motorcycle()
     gt = gt.astype(np.float32)
     gt[~np.isfinite(gt)] = np.nan
     bgr = [cv2.cvtColor(im, cv2.COLOR_RGB2BGR) for im in (left, right)]

@@ -40,7 +40,7 @@ def random_texture(rng: np.random.Generator, height: int, width: int, sigma: flo
                    contrast: float = 60.0, mean: float = 128.0) -> np.ndarray:
     """Band-limited random texture (float32 grey levels): blurred noise, then stretched."""
     noise = rng.standard_normal((height, width)).astype(np.float32)
-    tex = cv2.GaussianBlur(noise, (0, 0), sigma)
+    tex = np.asarray(cv2.GaussianBlur(noise, (0, 0), sigma), np.float32)
     tex *= contrast / max(float(tex.std()), 1e-6)
     return tex + mean
 

@@ -17,12 +17,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import cv2
 import numpy as np
 
 from host.errors import HostError
+
+if TYPE_CHECKING:
+    from host.stereo.params import MatcherParams
 
 KINDS = ("ground-truth", "depth", "coarse", "fixed")
 COARSE_FACTOR = 2
@@ -173,8 +176,8 @@ def _support(disp: np.ndarray) -> np.ndarray:
     return count
 
 
-def apply_range(params: Any, rng: tuple[int, int]) -> Any:
-    """params (MatcherParams) with the range; OpenCV's matchers get num rounded up to 16."""
+def apply_range(params: MatcherParams, rng: tuple[int, int]) -> MatcherParams:
+    """params with the range; OpenCV's matchers get num rounded up to 16."""
     lo, num = rng
     if params.matcher.startswith("opencv"):
         num = _round_up(num, 16)

@@ -59,6 +59,17 @@ class Run:
         return state, self.visited[state]
 
 
+@dataclass(frozen=True)
+class Move:
+    """One step of a Q learner on one parameter: from state s, action a (0 shrink, 1 keep,
+    2 grow), the reward it earned and the state it reached."""
+
+    s: int
+    a: int
+    reward: float
+    s_next: int
+
+
 @dataclass
 class TuneResult:
     method: str
@@ -68,6 +79,7 @@ class TuneResult:
     visited: list[tuple[State, float]]  # distinct states in the order this run evaluated them
     history: list[tuple[State, float]]  # one entry per iteration: state visited, its bad %
     q_table: dict[State, np.ndarray] = field(default_factory=dict)
+    moves: list[Move] = field(default_factory=list)  # paper and guided: every step, in order
 
     @property
     def evaluations(self) -> int:
@@ -123,9 +135,11 @@ def _greedy(values: np.ndarray, epsilon: float, rng: np.random.Generator, keep: 
 
 
 def _result(method: str, space: Space, run: Run, history: list[tuple[State, float]],
-            q: dict[State, np.ndarray] | None = None) -> TuneResult:
+            q: dict[State, np.ndarray] | None = None, moves: list[Move] | None = None
+            ) -> TuneResult:
     best, best_bad = run.best()
-    return TuneResult(method, space, best, best_bad, list(run.visited.items()), history, q or {})
+    return TuneResult(method, space, best, best_bad, list(run.visited.items()), history, q or {},
+                      moves or [])
 
 
 def _one_dimension(space: Space, method: str) -> int:
@@ -135,52 +149,54 @@ def _one_dimension(space: Space, method: str) -> int:
     return space.shape[0]
 
 
-def paper(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
-          gamma: float = 0.8, epsilon: float = 0.0, step: int = 1,
-          on_step: Callable[[], None] | None = None) -> TuneResult:
-    """The paper's learner as published: greedy on Q with random tie-breaks, equation 6."""
-    n = _one_dimension(space, "paper's")
+def _equation_6(method: str, obj: Run, space: Space, iterations: int, rng: np.random.Generator,
+                gamma: float, step: int, on_step: Callable[[], None] | None,
+                choose: Callable[[np.ndarray, Move | None], int]) -> TuneResult:
+    """The paper's loop on one parameter: Q from zeros, a random start state, then at each step
+    the action choose() takes from the state's Q row (and the last move), and equation 6."""
+    n = _one_dimension(space, "paper's" if method == "paper" else method)
     q = np.zeros((n, 3))  # actions: shrink, keep, grow
     s = int(rng.integers(n))
     bad_s = obj((s,))
     history: list[tuple[State, float]] = []
+    moves: list[Move] = []
     for _ in range(iterations):
-        if rng.random() < epsilon:
-            a = int(rng.integers(3))
-        else:
-            a = int(rng.choice(np.flatnonzero(q[s] == q[s].max())))
+        a = choose(q[s], moves[-1] if moves else None)
         s2 = min(max(s + (a - 1) * step, 0), n - 1)
         bad2 = obj((s2,))
+        moves.append(Move(s, a, bad_s - bad2, s2))
         paper_update(q, s, a, bad_s - bad2, s2, gamma)
         s, bad_s = s2, bad2
         history.append(((s2,), bad2))
         if on_step:
             on_step()
-    return _result("paper", space, obj, history, {(i,): q[i].copy() for i in range(n)})
+    return _result(method, space, obj, history, {(i,): q[i].copy() for i in range(n)}, moves)
+
+
+def paper(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
+          gamma: float = 0.8, epsilon: float = 0.0, step: int = 1,
+          on_step: Callable[[], None] | None = None) -> TuneResult:
+    """The paper's learner as published: greedy on Q with random tie-breaks, equation 6."""
+
+    def choose(row: np.ndarray, last: Move | None) -> int:
+        if rng.random() < epsilon:
+            return int(rng.integers(3))
+        return int(rng.choice(np.flatnonzero(row == row.max())))
+
+    return _equation_6("paper", obj, space, iterations, rng, gamma, step, on_step, choose)
 
 
 def guided(obj: Run, space: Space, iterations: int, rng: np.random.Generator,
            gamma: float = 0.8, epsilon: float = 0.2, step: int = 1,
            on_step: Callable[[], None] | None = None) -> TuneResult:
     """Equation 6 with the hill-climbing heuristics (see the module's docstring)."""
-    n = _one_dimension(space, "guided")
-    q = np.zeros((n, 3))  # actions: shrink, keep, grow
-    s = int(rng.integers(n))
-    bad_s = obj((s,))
-    history: list[tuple[State, float]] = []
-    prefer = None
-    for _ in range(iterations):
-        a = _greedy(q[s], epsilon, rng, keep=1, prefer=prefer)
-        s2 = min(max(s + (a - 1) * step, 0), n - 1)
-        bad2 = obj((s2,))
-        reward = bad_s - bad2
-        paper_update(q, s, a, reward, s2, gamma)
-        prefer = a if reward > 0 else 2 - a  # repeat an improving move, else undo it
-        s, bad_s = s2, bad2
-        history.append(((s2,), bad2))
-        if on_step:
-            on_step()
-    return _result("guided", space, obj, history, {(i,): q[i].copy() for i in range(n)})
+
+    def choose(row: np.ndarray, last: Move | None) -> int:
+        # repeat an improving move, else undo it
+        prefer = None if last is None else last.a if last.reward > 0 else 2 - last.a
+        return _greedy(row, epsilon, rng, keep=1, prefer=prefer)
+
+    return _equation_6("guided", obj, space, iterations, rng, gamma, step, on_step, choose)
 
 
 def qlearning(obj: Run, space: Space, iterations: int, rng: np.random.Generator,

@@ -18,14 +18,20 @@ from rosbags.highlevel import AnyReader  # noqa: E402
 from host.sim.renderer import Renderer  # noqa: E402
 from host.sim.world import World  # noqa: E402
 
+from ..in_process import host  # noqa: E402
 
-def _pairs(folder: Path, frames: int = 3) -> None:
+
+@pytest.fixture(scope="module")
+def src(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Three rendered pairs, the robot nearer in each, as a folder for --camera replay:."""
+    folder = tmp_path_factory.mktemp("src")
     renderer = Renderer(World())
-    for i in range(frames):
+    for i in range(3):
         renderer.world.robot.z_m -= 0.05  # each pair its own
         pair = renderer.frame(with_robot=True)
         cv2.imwrite(str(folder / f"left_{i:03d}.png"), pair.left)
         cv2.imwrite(str(folder / f"right_{i:03d}.png"), pair.right)
+    return folder
 
 
 def _read(path: Path) -> dict[str, list]:
@@ -47,10 +53,7 @@ def _image(msg) -> np.ndarray:
         msg.height, msg.width, -1).squeeze()
 
 
-def test_capture_records_every_pair(tmp_path: Path) -> None:
-    src = tmp_path / "src"
-    src.mkdir()
-    _pairs(src)
+def test_capture_records_every_pair(src: Path, tmp_path: Path) -> None:
     rec = tmp_path / "capture.mcap"
     r = _host("capture", "--camera", f"replay:{src}", "--count", "3", "--interval", "0",
               "--out", str(tmp_path / "out"), "--record", str(rec))
@@ -63,10 +66,7 @@ def test_capture_records_every_pair(tmp_path: Path) -> None:
     assert "/stereo/disparity" not in topics  # capture computes none
 
 
-def test_view_records_the_maps_it_showed(tmp_path: Path) -> None:
-    src = tmp_path / "src"
-    src.mkdir()
-    _pairs(src)
+def test_view_records_the_maps_it_showed(src: Path, tmp_path: Path) -> None:
     rec = tmp_path / "view.mcap"
     r = _host("view", "--camera", f"replay:{src}", "--border", "clip", "--num-disp", "48",
               "--duration", "4", "--record", str(rec))
@@ -83,10 +83,10 @@ def test_view_records_the_maps_it_showed(tmp_path: Path) -> None:
 def test_an_existing_recording_is_never_overwritten(tmp_path: Path) -> None:
     rec = tmp_path / "old.mcap"
     rec.write_bytes(b"the user's")
-    r = _host("servo", "--sim", "--record", str(rec))
+    r = host("servo", "--sim", "--record", str(rec))
     assert r.returncode == 2 and "exists already" in r.stderr
     assert r.stderr.count("\n") == 1 and rec.read_bytes() == b"the user's"
-    r = _host("servo", "--sim", "--record", str(tmp_path / "run.bag"))
+    r = host("servo", "--sim", "--record", str(tmp_path / "run.bag"))
     assert r.returncode == 2 and "name it .mcap" in r.stderr
 
 
@@ -97,7 +97,7 @@ def test_options_that_cannot_go_together_are_one_line(tmp_path: Path) -> None:
              "not with --trials"),
             (["--sim", "--view-wait"], "give --view too"),
             (["--camera", f"replay:{missing}", "--port", "emulator"], "no such recording")):
-        r = _host("servo", *args)
+        r = host("servo", *args)
         assert r.returncode == 2 and words in r.stderr, r.stderr
         assert r.stderr.count("\n") == 1
     assert not (tmp_path / "t.mcap").exists()

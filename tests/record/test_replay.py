@@ -68,7 +68,7 @@ def test_a_replay_that_runs_out_says_so(run):
 
 
 def test_tune_gets_the_same_pairs_from_a_bag_as_from_their_folder(run, tmp_path):
-    from host.commands.tune import _camera_scenes
+    from host.commands.tune import camera_scenes
 
     path, _, seen, recorded = run
     for i, (frame, _) in enumerate(seen):
@@ -78,7 +78,7 @@ def test_tune_gets_the_same_pairs_from_a_bag_as_from_their_folder(run, tmp_path)
     def scenes(camera: str):
         args = argparse.Namespace(camera=camera, calib=None, frames=4, size="320x240",
                                   speed=None, swap_check="off")
-        return _camera_scenes(args)
+        return camera_scenes(args)
 
     from_bag, focal_baseline = scenes(f"replay:{path}")
     from_folder, _ = scenes(f"replay:{tmp_path}")

@@ -69,30 +69,23 @@ def test_multi_parameter_methods_find_the_optimum_of_a_4d_landscape(method, iter
         assert r.evaluations < FOUR_D.size * 0.3
 
 
-def test_the_paper_learner_is_greedy_equation_6_from_zeros(monkeypatch) -> None:
-    import host.tuning.learners as learners
-
-    calls = []
-    real = learners.paper_update
-
-    def spy(q, s, a, reward, s_next, gamma):
-        calls.append((q.copy(), s, a, reward, s_next, gamma))
-        real(q, s, a, reward, s_next, gamma)
-
-    monkeypatch.setattr(learners, "paper_update", spy)
+def test_the_paper_learner_is_greedy_equation_6_from_zeros() -> None:
+    # its moves, replayed from a Q of zeros with equation 6: each action was greedy on the Q
+    # of its time, and the replay ends on the learner's own Q table
     starts = set()
     for seed in range(8):
-        calls.clear()
         r = tune("paper", Objective(bowl_1d), WINDOW, 20, seed)
-        assert len(calls) == len(r.history) == 20
-        assert not calls[0][0].any()  # Q starts at zero
-        starts.add(calls[0][1])
-        for q, s, a, reward, s_next, gamma in calls:
-            assert q[s, a] == q[s].max()  # greedy (ties drawn at random)
-            assert s_next == min(max(s + a - 1, 0), WINDOW.shape[0] - 1)
-            assert reward == pytest.approx(bowl_1d((s,)) - bowl_1d((s_next,)))
-            assert gamma == 0.8
-        assert [(s2,) for *_, s2, _ in calls] == [s for s, _ in r.history]
+        assert len(r.moves) == len(r.history) == 20
+        q = np.zeros((WINDOW.shape[0], 3))
+        for m in r.moves:
+            assert q[m.s, m.a] == q[m.s].max()  # greedy (ties drawn at random)
+            assert m.s_next == min(max(m.s + m.a - 1, 0), WINDOW.shape[0] - 1)
+            assert m.reward == pytest.approx(bowl_1d((m.s,)) - bowl_1d((m.s_next,)))
+            paper_update(q, m.s, m.a, m.reward, m.s_next, gamma=0.8)
+        np.testing.assert_array_equal(q, [r.q_table[(i,)] for i in range(WINDOW.shape[0])])
+        assert [(m.s_next,) for m in r.moves] == [s for s, _ in r.history]
+        assert all(a.s_next == b.s for a, b in zip(r.moves, r.moves[1:]))
+        starts.add(r.moves[0].s)
     assert len(starts) > 3  # a random start state
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import subprocess
 
 import numpy as np
 import pytest
@@ -12,6 +13,8 @@ from host.stereo.synthetic import synthetic_scene
 from host.tuning.disparity_range import RangePolicy
 from host.tuning.ground_truth import GroundTruthScore
 from host.tuning.self_supervised import SelfSupervisedScore, score_of, terms_of_maps
+
+from ..in_process import host
 
 
 @pytest.fixture(scope="module")
@@ -118,12 +121,8 @@ def test_the_census_is_made_once_per_process_and_never_sent(scene) -> None:
         backend.close()
 
 
-def _tune(*argv: str):
-    import subprocess
-    import sys
-
-    return subprocess.run([sys.executable, "-m", "host", "tune", *argv], capture_output=True,
-                          text=True)
+def _tune(*argv: str) -> subprocess.CompletedProcess[str]:
+    return host("tune", *argv)
 
 
 def test_tune_on_replayed_frames_without_ground_truth(tmp_path, scene) -> None:

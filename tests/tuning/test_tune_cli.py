@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import cv2
@@ -21,6 +19,8 @@ from host.tuning.ground_truth import GroundTruthScore
 from host.tuning.learners import tune
 from host.tuning.objective import Objective, SceneTable
 from host.tuning.spaces import make_space, odd_range
+
+from ..in_process import host
 
 
 def gt_objective(scenes, space, workers: int = 1) -> Objective:
@@ -84,9 +84,10 @@ def test_tuned_params_round_trip_into_eval(tmp_path: Path, capsys) -> None:
     assert row["matcher"]["block_size"] == load_params(out)[0].block_size
 
 
-def _run(*argv: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "host", "tune", *argv], capture_output=True,
-                          text=True)
+def _run(*argv: str) -> tuple[int, str]:
+    """host tune in this process: (exit status, stderr)."""
+    r = host("tune", *argv)
+    return r.returncode, r.stderr
 
 
 @pytest.mark.parametrize("argv, message", [
@@ -99,22 +100,22 @@ def _run(*argv: str) -> subprocess.CompletedProcess[str]:
     (["--method", "grid", "--gamma", "0.5"], "takes no learning parameters"),
 ])
 def test_bad_input_is_a_one_line_error(argv: list[str], message: str) -> None:
-    r = _run(*argv)
-    assert r.returncode == 2 and message in r.stderr and r.stderr.count("\n") == 1
+    code, err = _run(*argv)
+    assert code == 2 and message in err and err.count("\n") == 1
 
 
 def test_a_scene_without_ground_truth_is_refused(tmp_path: Path) -> None:
     for name in ("im0.png", "im1.png"):
         cv2.imwrite(str(tmp_path / name), np.zeros((40, 80), np.uint8))
-    r = _run(str(tmp_path))
-    assert r.returncode == 2 and "no ground truth" in r.stderr
+    code, err = _run(str(tmp_path))
+    assert code == 2 and "no ground truth" in err
 
 
 def test_an_interrupted_run_leaves_no_params_file(tmp_path: Path) -> None:
     out = tmp_path / "p.toml"
     out.write_text("[matcher]\nblock_size = 7\n")
-    r = _run("--iterations", "0", "--out", str(out))
-    assert r.returncode == 2 and out.read_text() == "[matcher]\nblock_size = 7\n"
+    code, _ = _run("--iterations", "0", "--out", str(out))
+    assert code == 2 and out.read_text() == "[matcher]\nblock_size = 7\n"
 
 
 def test_parallel_workers_give_the_same_result_as_one_process(scene) -> None:
@@ -136,3 +137,23 @@ def test_learning_parameters_reach_the_learner(capsys) -> None:
     assert main(argv + ["--epsilon", "1.0", "--episodes", "1"]) == 0
     random_walk = json.loads(capsys.readouterr().out)["history"]
     assert greedy != random_walk
+
+
+def test_the_job_runs_without_writing_and_the_report_writes(tmp_path: Path, capsys) -> None:
+    """host tune in its three steps: the checked job, a run that writes and prints nothing, and
+    the report that writes the parameters and prints the line."""
+    from host.cli import build_parser
+    from host.commands.tune import TuneJob, report, run_job
+
+    out = tmp_path / "p.toml"
+    args = build_parser("host").parse_args(["tune", "--method", "grid", "--windows", "7:11",
+                                            "--out", str(out)])
+    job = TuneJob.from_args(args)
+    assert (job.method, job.iterations, [s.name for s in job.tuned_on]) == \
+        ("grid", 0, ["motorcycle"])
+    done = run_job(job)
+    assert not out.exists() and capsys.readouterr() == ("", "")
+    assert done.result.evaluations == 3 and done.best.block_size in (7, 9, 11)
+    report(job, done)
+    assert load_params(out)[0] == done.best
+    assert capsys.readouterr().out.startswith("grid on window over motorcycle: best ")

@@ -5,9 +5,6 @@ from __future__ import annotations
 
 import asyncio
 import json
-import re
-import subprocess
-import sys
 import urllib.error
 import urllib.request
 from pathlib import Path
@@ -18,6 +15,9 @@ import numpy as np
 
 from host.sim.renderer import Renderer
 from host.sim.world import World
+
+from ..in_process import host
+from .running import host_view
 
 
 def _recording(folder: Path, frames: int = 3) -> None:
@@ -30,16 +30,8 @@ def _recording(folder: Path, frames: int = 3) -> None:
 
 def test_view_shows_a_recording_without_stop(tmp_path: Path) -> None:
     _recording(tmp_path)
-    proc = subprocess.Popen([sys.executable, "-m", "host", "view", "--camera",
-                             f"replay:{tmp_path}", "--border", "clip", "--num-disp", "48",
-                             "--duration", "60"], stderr=subprocess.PIPE, text=True)
-    try:
-        line = ""
-        while not line.startswith("live view: "):
-            line = proc.stderr.readline()  # type: ignore[union-attr]
-            assert line, "host view ended without printing its address"
-        url = re.search(r"http://(\S+)/", line)[1]  # type: ignore[index]
-
+    with host_view("--camera", f"replay:{tmp_path}", "--border", "clip", "--num-disp", "48",
+                   "--duration", "60") as url:
         async def one_update() -> tuple[dict, list[bytes]]:
             async with aiohttp.ClientSession() as s, s.ws_connect(f"ws://{url}/updates") as ws:
                 await ws.send_str("next")
@@ -60,13 +52,9 @@ def test_view_shows_a_recording_without_stop(tmp_path: Path) -> None:
         except urllib.error.HTTPError as e:
             status = e.code
         assert status == 409  # no robot: STOP has nothing to act on
-    finally:
-        proc.terminate()
-        proc.wait(timeout=10)
 
 
 def test_bad_view_address_is_one_line(tmp_path: Path) -> None:
-    r = subprocess.run([sys.executable, "-m", "host", "servo", "--sim", "--view", "here:there"],
-                       capture_output=True, text=True, timeout=120)
+    r = host("servo", "--sim", "--view", "here:there")
     assert r.returncode == 2 and "--view must be [HOST:]PORT" in r.stderr
     assert r.stderr.count("\n") == 1
