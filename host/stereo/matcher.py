@@ -147,6 +147,20 @@ def _sgm_sums(shape: tuple[int, ...], nd: int, dtype=np.uint16) -> np.ndarray:
     return out
 
 
+def _four_path(shape: tuple[int, ...], nd: int, cmax: int, p2: int, rows_made: bool,
+               stripes: int) -> sgm.FourPath:
+    """The 4-path pass's buffers (sgm.FourPath), reused by the next call of the same size and
+    costs in this thread (so its blocks take no fresh pages: no page faults in steady state)."""
+    key = (shape[0], shape[1], nd, cmax, p2, rows_made, stripes)
+    kept = getattr(_VOLUMES, "four", None)
+    if kept is not None and kept[0] == key:
+        return kept[1]
+    _VOLUMES.four = None
+    out = sgm.FourPath.make(shape[0], shape[1], nd, cmax, p2, rows_made, stripes)
+    _VOLUMES.four = (key, out)
+    return out
+
+
 NO_VOLUME = sgm.NO_VOLUME
 
 
@@ -186,18 +200,22 @@ def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
         vol = sgm.box_sum(vol, p.block_size)
     p1, p2 = sgm_penalties(p)
     want_right = p.lr_check is not None
-    # the 5-path pass decides each row as it goes: no sum volume
-    sums = _sgm_sums(gl.shape if p.paths != 5 else (0, 0), p.num_disparities)
-    # with 4 or 8 paths each cost row is kept (uint8) for the second direction: made once
+    # only the 8-path scheme keeps a sum volume; the 5- and 4-path passes decide each row as
+    # they go (the 4-path one from a stored row of its path from the bottom every K rows)
+    sums = _sgm_sums(gl.shape if p.paths == 8 else (0, 0), p.num_disparities)
+    # with 8 paths each cost row is kept (uint8) for the second direction: made once
     costs = sgm.NO_COSTS
-    if p.paths != 5 and vol.shape[0] == 0 and term[5] <= 255:
+    if p.paths == 8 and vol.shape[0] == 0 and term[5] <= 255:
         costs = _sgm_sums(gl.shape, p.num_disparities, np.uint8)
+    four = _four_path(gl.shape, p.num_disparities, sgm.largest_cost(vol, term), p2,
+                      vol.shape[0] == 0, (1 if numba.get_num_threads() < 2 else 2)
+                      if p.paths == 4 else 0)
     crrev = sgm.reversed_right(cr, p.min_disparity, p.num_disparities)
     del cr  # 8 bytes a pixel less at the peak
     disp_l, disp_r = sgm.match(cl, crrev, vol, sums, p.min_disparity,
                                np.uint16(p1), np.uint16(p2), p.paths,
                                float(p.uniqueness_ratio), subpixel_fit(p), want_right, False,
-                               planes, rplanes, term, costs)
+                               planes, rplanes, term, costs, four)
     del cl, crrev, vol, planes, rplanes, costs
     if want_right:
         # the right map has whole pixels: with a sub-pixel left map a tolerance under half a
