@@ -173,12 +173,14 @@ def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
     cl, cr = [sgm.census(cv2.copyMakeBorder(g, sgm.CENSUS_H, sgm.CENSUS_H, sgm.CENSUS_W,
                                             sgm.CENSUS_W, cv2.BORDER_REPLICATE))
               for g in (gl, gr)]
+    shape = gl.shape
+    del gl, gr  # 2 bytes a pixel less at the peak
     vol, planes, rplanes, term = NO_VOLUME, sgm.NO_PLANES, sgm.NO_PLANES, sgm.census_term()
     if p.intensity_weight > 0 or p.outside_cost != sgm.CENSUS_BITS:
         pl, pr = _planes(left, p.colour), _planes(right, p.colour)
         # the intensity term sees the right image with the left one's levels (per channel),
         # the table taken from the columns both cameras see (not the strip beside each edge)
-        cut = min(p.min_disparity + p.num_disparities, gl.shape[1] // 2)
+        cut = min(p.min_disparity + p.num_disparities, shape[1] // 2)
         pr = np.stack([match_histogram(b, a, b[:, :b.shape[1] - cut], a[:, cut:])
                        for a, b in zip(pl, pr)])
         weight = float(p.intensity_weight)
@@ -190,11 +192,12 @@ def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
             planes, rplanes = pl, reversed_planes(pr, p.min_disparity, p.num_disparities)
         else:
             term = sgm.census_term()
-            vol = np.empty((*gl.shape, p.num_disparities), dtype=np.uint16)
+            vol = np.empty((*shape, p.num_disparities), dtype=np.uint16)
             vol = census_ad_volume(cl, cr, pl, pr, p.min_disparity, weight, p.intensity_cap,
                                    p.outside_cost, vol)
+        del pr  # reversed (rplanes) or in the volume: 3 bytes a pixel less at the peak
     elif p.block_size > 1:
-        vol = np.empty((*gl.shape, p.num_disparities), dtype=np.uint16)
+        vol = np.empty((*shape, p.num_disparities), dtype=np.uint16)
         vol = sgm.hamming_volume(cl, cr, p.min_disparity, vol)
     if p.block_size > 1:
         vol = sgm.box_sum(vol, p.block_size)
@@ -202,12 +205,12 @@ def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
     want_right = p.lr_check is not None
     # only the 8-path scheme keeps a sum volume; the 5- and 4-path passes decide each row as
     # they go (the 4-path one from a stored row of its path from the bottom every K rows)
-    sums = _sgm_sums(gl.shape if p.paths == 8 else (0, 0), p.num_disparities)
+    sums = _sgm_sums(shape if p.paths == 8 else (0, 0), p.num_disparities)
     # with 8 paths each cost row is kept (uint8) for the second direction: made once
     costs = sgm.NO_COSTS
     if p.paths == 8 and vol.shape[0] == 0 and term[5] <= 255:
-        costs = _sgm_sums(gl.shape, p.num_disparities, np.uint8)
-    four = _four_path(gl.shape, p.num_disparities, sgm.largest_cost(vol, term), p2,
+        costs = _sgm_sums(shape, p.num_disparities, np.uint8)
+    four = _four_path(shape, p.num_disparities, sgm.largest_cost(vol, term), p2,
                       vol.shape[0] == 0, (1 if numba.get_num_threads() < 2 else 2)
                       if p.paths == 4 else 0)
     crrev = sgm.reversed_right(cr, p.min_disparity, p.num_disparities)
