@@ -9,6 +9,7 @@ from collections.abc import Iterator
 import cv2
 import numba
 import numpy as np
+from numpy.typing import DTypeLike
 
 from host.errors import HostError
 from host.stereo import block_matching as bm
@@ -82,9 +83,10 @@ def own_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
                                    p.block_size // 2, kind, float(p.uniqueness_ratio),
                                    subpixel_fit(p), want_right, p.border == "clip",
                                    sl, ql, sr, qr)
-    if want_right:
+    if p.lr_check is not None:  # want_right
         disp_l = lr_consistency(disp_l, disp_r, float(p.lr_check))
-    return disp_l
+    out: np.ndarray = disp_l
+    return out
 
 
 def subpixel_fit(p: MatcherParams) -> int:
@@ -106,9 +108,10 @@ def sad_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
                                        p.block_size // 2, float(p.uniqueness_ratio),
                                        subpixel_fit(p), want_right, p.border == "clip",
                                        np.empty(0, cdt), np.empty(0, wdt), np.iinfo(wdt).max, n)
-    if want_right:
+    if p.lr_check is not None:  # want_right
         disp_l = lr_consistency(disp_l, disp_r, float(p.lr_check))
-    return disp_l
+    out: np.ndarray = disp_l
+    return out
 
 
 def sgm_penalties(p: MatcherParams) -> tuple[int, int]:
@@ -125,7 +128,7 @@ _VOLUMES = threading.local()
 KEEP_BYTES = 512 << 20  # sum volumes up to this size are kept for the next call of the same size
 
 
-def _sgm_sums(shape: tuple[int, ...], nd: int, dtype=np.uint16) -> np.ndarray:
+def _sgm_sums(shape: tuple[int, ...], nd: int, dtype: DTypeLike = np.uint16) -> np.ndarray:
     """The path-sum volume for SGM (uint16) or its kept cost rows (uint8), reused by the next
     call on the same size in this thread: a fresh 39 MB costs several ms of page faults per
     call at 640x480 / 64, a fresh 315 MB at 1280x960 / 128 (the 4-path default) 809 faults and
@@ -134,7 +137,7 @@ def _sgm_sums(shape: tuple[int, ...], nd: int, dtype=np.uint16) -> np.ndarray:
     key = (shape[0], shape[1], nd)
     if not key[0]:
         return np.empty(key, dtype=dtype)
-    kept = getattr(_VOLUMES, "kept", None)
+    kept: dict[str, np.ndarray] | None = getattr(_VOLUMES, "kept", None)
     if kept is None:
         kept = _VOLUMES.kept = {}
     got = kept.get(np.dtype(dtype).char)
@@ -154,7 +157,8 @@ def _four_path(shape: tuple[int, ...], nd: int, cmax: int, p2: int, rows_made: b
     key = (shape[0], shape[1], nd, cmax, p2, rows_made, stripes)
     kept = getattr(_VOLUMES, "four", None)
     if kept is not None and kept[0] == key:
-        return kept[1]
+        got: sgm.FourPath = kept[1]
+        return got
     _VOLUMES.four = None
     out = sgm.FourPath.make(shape[0], shape[1], nd, cmax, p2, rows_made, stripes)
     _VOLUMES.four = (key, out)
@@ -184,11 +188,12 @@ def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
         pr = np.stack([match_histogram(b, a, b[:, :b.shape[1] - cut], a[:, cut:])
                        for a, b in zip(pl, pr)])
         weight = float(p.intensity_weight)
-        term = None
+        fused = None
         if p.block_size == 1 and pl.shape[0] in (1, 3):
-            term = integer_term(pl.shape[0], weight, p.intensity_cap, p.outside_cost)
-        if term is not None:
+            fused = integer_term(pl.shape[0], weight, p.intensity_cap, p.outside_cost)
+        if fused is not None:
             # the cost row by row inside the aggregation: no cost volume
+            term = fused
             planes, rplanes = pl, reversed_planes(pr, p.min_disparity, p.num_disparities)
         else:
             term = sgm.census_term()
@@ -220,7 +225,7 @@ def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
                                float(p.uniqueness_ratio), subpixel_fit(p), want_right, False,
                                planes, rplanes, term, costs, four)
     del cl, crrev, vol, planes, rplanes, costs
-    if want_right:
+    if p.lr_check is not None:  # want_right
         # the right map has whole pixels: with a sub-pixel left map a tolerance under half a
         # pixel (LR 0, the default) means the same winner, not no sub-pixel result at all
         tol = float(p.lr_check)

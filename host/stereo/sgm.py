@@ -1,11 +1,11 @@
-"""Own semi-global matcher: census Hamming cost, 8-path aggregation in two streaming passes, WTA.
+"""Own semi-global matcher: census Hamming cost, 4-, 5- or 8-path aggregation, WTA.
 
 Cost: a 9x7 census of the grey images (62 bits, replicated border) compared by Hamming
-distance, summed over a block_size x block_size box when block_size > 1. Aggregation
-(Hirschmueller's recurrence) along 8 directions: a forward pass (rows top to bottom, x left to
-right) carries the paths from the left, top-left, top and top-right; the backward pass the four
-opposite ones. The passes are independent, so with two threads they run at once, each into its
-own sum volume; each keeps only two rows of path costs. Path costs, sums and penalties are
+distance (plus, with planes, the intensity term), made row by row where it is used, or a
+box-summed volume when block_size > 1. Aggregation (Hirschmueller's recurrence): 5 paths in one
+pass from the top (_down); 8 paths as two directions that each store their sums for half the
+image (_sweep); 4 paths, the defaults, in blocks of K rows from a stored row of the path from
+the bottom every K rows, with no volume (_vertical, _four). Path costs, sums and penalties are
 uint16 with the disparity axis innermost, so every per-disparity loop runs in 16-bit lanes.
 
 Candidate j is disparity dmin + j; the left pixel x matches right pixel x - d. A candidate
@@ -746,8 +746,12 @@ def census_term(outside: int = CENSUS_BITS) -> np.ndarray:
     return np.array([outside, 0, 0, 0, 0, max(CENSUS_BITS, outside)], dtype=np.int64)
 
 
-def match(cl, crrev, vol, S, dmin, p1, p2, paths, uniqueness, fit, want_right, keep,
-          pl=NO_PLANES, prrev=NO_PLANES, term=None, costs=NO_COSTS, four=None):
+def match(cl: np.ndarray, crrev: np.ndarray, vol: np.ndarray, S: np.ndarray, dmin: int,
+          p1: np.uint16, p2: np.uint16, paths: int, uniqueness: float, fit: int,
+          want_right: bool, keep: bool, pl: np.ndarray = NO_PLANES,
+          prrev: np.ndarray = NO_PLANES, term: np.ndarray | None = None,
+          costs: np.ndarray = NO_COSTS, four: FourPath | None = None
+          ) -> tuple[np.ndarray, np.ndarray]:
     """_match with the cost from vol, or (vol empty) from the census rows plus, where pl has
     channels, the intensity term of the planes pl and prrev (cost.reversed_planes) as
     term says (cost.integer_term; default: census alone, CENSUS_BITS outside the image).
@@ -761,9 +765,12 @@ def match(cl, crrev, vol, S, dmin, p1, p2, paths, uniqueness, fit, want_right, k
     if four is None:
         four = FourPath.make(h, w, nd, largest_cost(vol, term), int(p2), vol.shape[0] == 0,
                              1 if paths == 4 else 0)
-    return _match(cl, crrev, vol, pl, prrev, term, S, costs, dmin, p1, p2, paths, uniqueness,
-                  fit, want_right, keep, four.K, four.ck, four.ckm, four.top, four.topm,
-                  four.BB, four.CB)
+    disp_l: np.ndarray
+    disp_r: np.ndarray
+    disp_l, disp_r = _match(cl, crrev, vol, pl, prrev, term, S, costs, dmin, p1, p2, paths,
+                            uniqueness, fit, want_right, keep, four.K, four.ck, four.ckm,
+                            four.top, four.topm, four.BB, four.CB)
+    return disp_l, disp_r
 
 
 def largest_cost(vol: np.ndarray, term: np.ndarray) -> int:
