@@ -9,6 +9,7 @@ from collections.abc import Iterator
 import cv2
 import numba
 import numpy as np
+from numpy.typing import DTypeLike
 
 from host.errors import HostError
 from host.stereo import block_matching as bm
@@ -82,9 +83,10 @@ def own_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
                                    p.block_size // 2, kind, float(p.uniqueness_ratio),
                                    subpixel_fit(p), want_right, p.border == "clip",
                                    sl, ql, sr, qr)
-    if want_right:
+    if p.lr_check is not None:  # want_right
         disp_l = lr_consistency(disp_l, disp_r, float(p.lr_check))
-    return disp_l
+    out: np.ndarray = disp_l
+    return out
 
 
 def subpixel_fit(p: MatcherParams) -> int:
@@ -106,9 +108,10 @@ def sad_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
                                        p.block_size // 2, float(p.uniqueness_ratio),
                                        subpixel_fit(p), want_right, p.border == "clip",
                                        np.empty(0, cdt), np.empty(0, wdt), np.iinfo(wdt).max, n)
-    if want_right:
+    if p.lr_check is not None:  # want_right
         disp_l = lr_consistency(disp_l, disp_r, float(p.lr_check))
-    return disp_l
+    out: np.ndarray = disp_l
+    return out
 
 
 def sgm_penalties(p: MatcherParams) -> tuple[int, int]:
@@ -125,7 +128,7 @@ _VOLUMES = threading.local()
 KEEP_BYTES = 512 << 20  # sum volumes up to this size are kept for the next call of the same size
 
 
-def _sgm_sums(shape: tuple[int, ...], nd: int, dtype=np.uint16) -> np.ndarray:
+def _sgm_sums(shape: tuple[int, ...], nd: int, dtype: DTypeLike = np.uint16) -> np.ndarray:
     """The path-sum volume for SGM (uint16) or its kept cost rows (uint8), reused by the next
     call on the same size in this thread: a fresh 39 MB costs several ms of page faults per
     call at 640x480 / 64, a fresh 315 MB at 1280x960 / 128 (the 4-path default) 809 faults and
@@ -134,7 +137,7 @@ def _sgm_sums(shape: tuple[int, ...], nd: int, dtype=np.uint16) -> np.ndarray:
     key = (shape[0], shape[1], nd)
     if not key[0]:
         return np.empty(key, dtype=dtype)
-    kept = getattr(_VOLUMES, "kept", None)
+    kept: dict[str, np.ndarray] | None = getattr(_VOLUMES, "kept", None)
     if kept is None:
         kept = _VOLUMES.kept = {}
     got = kept.get(np.dtype(dtype).char)
@@ -144,6 +147,21 @@ def _sgm_sums(shape: tuple[int, ...], nd: int, dtype=np.uint16) -> np.ndarray:
     out = np.empty(key, dtype=dtype)
     if out.nbytes <= KEEP_BYTES:
         kept[np.dtype(dtype).char] = out
+    return out
+
+
+def _four_path(shape: tuple[int, ...], nd: int, cmax: int, p2: int, rows_made: bool,
+               stripes: int) -> sgm.FourPath:
+    """The 4-path pass's buffers (sgm.FourPath), reused by the next call of the same size and
+    costs in this thread (so its blocks take no fresh pages: no page faults in steady state)."""
+    key = (shape[0], shape[1], nd, cmax, p2, rows_made, stripes)
+    kept = getattr(_VOLUMES, "four", None)
+    if kept is not None and kept[0] == key:
+        got: sgm.FourPath = kept[1]
+        return got
+    _VOLUMES.four = None
+    out = sgm.FourPath.make(shape[0], shape[1], nd, cmax, p2, rows_made, stripes)
+    _VOLUMES.four = (key, out)
     return out
 
 
@@ -159,47 +177,55 @@ def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
     cl, cr = [sgm.census(cv2.copyMakeBorder(g, sgm.CENSUS_H, sgm.CENSUS_H, sgm.CENSUS_W,
                                             sgm.CENSUS_W, cv2.BORDER_REPLICATE))
               for g in (gl, gr)]
+    shape = gl.shape
+    del gl, gr  # 2 bytes a pixel less at the peak
     vol, planes, rplanes, term = NO_VOLUME, sgm.NO_PLANES, sgm.NO_PLANES, sgm.census_term()
     if p.intensity_weight > 0 or p.outside_cost != sgm.CENSUS_BITS:
         pl, pr = _planes(left, p.colour), _planes(right, p.colour)
         # the intensity term sees the right image with the left one's levels (per channel),
         # the table taken from the columns both cameras see (not the strip beside each edge)
-        cut = min(p.min_disparity + p.num_disparities, gl.shape[1] // 2)
+        cut = min(p.min_disparity + p.num_disparities, shape[1] // 2)
         pr = np.stack([match_histogram(b, a, b[:, :b.shape[1] - cut], a[:, cut:])
                        for a, b in zip(pl, pr)])
         weight = float(p.intensity_weight)
-        term = None
+        fused = None
         if p.block_size == 1 and pl.shape[0] in (1, 3):
-            term = integer_term(pl.shape[0], weight, p.intensity_cap, p.outside_cost)
-        if term is not None:
+            fused = integer_term(pl.shape[0], weight, p.intensity_cap, p.outside_cost)
+        if fused is not None:
             # the cost row by row inside the aggregation: no cost volume
+            term = fused
             planes, rplanes = pl, reversed_planes(pr, p.min_disparity, p.num_disparities)
         else:
             term = sgm.census_term()
-            vol = np.empty((*gl.shape, p.num_disparities), dtype=np.uint16)
+            vol = np.empty((*shape, p.num_disparities), dtype=np.uint16)
             vol = census_ad_volume(cl, cr, pl, pr, p.min_disparity, weight, p.intensity_cap,
                                    p.outside_cost, vol)
+        del pr  # reversed (rplanes) or in the volume: 3 bytes a pixel less at the peak
     elif p.block_size > 1:
-        vol = np.empty((*gl.shape, p.num_disparities), dtype=np.uint16)
+        vol = np.empty((*shape, p.num_disparities), dtype=np.uint16)
         vol = sgm.hamming_volume(cl, cr, p.min_disparity, vol)
     if p.block_size > 1:
         vol = sgm.box_sum(vol, p.block_size)
     p1, p2 = sgm_penalties(p)
     want_right = p.lr_check is not None
-    # the 5-path pass decides each row as it goes: no sum volume
-    sums = _sgm_sums(gl.shape if p.paths != 5 else (0, 0), p.num_disparities)
-    # with 4 or 8 paths each cost row is kept (uint8) for the second direction: made once
+    # only the 8-path scheme keeps a sum volume; the 5- and 4-path passes decide each row as
+    # they go (the 4-path one from a stored row of its path from the bottom every K rows)
+    sums = _sgm_sums(shape if p.paths == 8 else (0, 0), p.num_disparities)
+    # with 8 paths each cost row is kept (uint8) for the second direction: made once
     costs = sgm.NO_COSTS
-    if p.paths != 5 and vol.shape[0] == 0 and term[5] <= 255:
-        costs = _sgm_sums(gl.shape, p.num_disparities, np.uint8)
+    if p.paths == 8 and vol.shape[0] == 0 and term[5] <= 255:
+        costs = _sgm_sums(shape, p.num_disparities, np.uint8)
+    four = _four_path(shape, p.num_disparities, sgm.largest_cost(vol, term), p2,
+                      vol.shape[0] == 0, (1 if numba.get_num_threads() < 2 else 2)
+                      if p.paths == 4 else 0)
     crrev = sgm.reversed_right(cr, p.min_disparity, p.num_disparities)
     del cr  # 8 bytes a pixel less at the peak
     disp_l, disp_r = sgm.match(cl, crrev, vol, sums, p.min_disparity,
                                np.uint16(p1), np.uint16(p2), p.paths,
                                float(p.uniqueness_ratio), subpixel_fit(p), want_right, False,
-                               planes, rplanes, term, costs)
+                               planes, rplanes, term, costs, four)
     del cl, crrev, vol, planes, rplanes, costs
-    if want_right:
+    if p.lr_check is not None:  # want_right
         # the right map has whole pixels: with a sub-pixel left map a tolerance under half a
         # pixel (LR 0, the default) means the same winner, not no sub-pixel result at all
         tol = float(p.lr_check)

@@ -1,11 +1,11 @@
-"""Own semi-global matcher: census Hamming cost, 8-path aggregation in two streaming passes, WTA.
+"""Own semi-global matcher: census Hamming cost, 4-, 5- or 8-path aggregation, WTA.
 
 Cost: a 9x7 census of the grey images (62 bits, replicated border) compared by Hamming
-distance, summed over a block_size x block_size box when block_size > 1. Aggregation
-(Hirschmueller's recurrence) along 8 directions: a forward pass (rows top to bottom, x left to
-right) carries the paths from the left, top-left, top and top-right; the backward pass the four
-opposite ones. The passes are independent, so with two threads they run at once, each into its
-own sum volume; each keeps only two rows of path costs. Path costs, sums and penalties are
+distance (plus, with planes, the intensity term), made row by row where it is used, or a
+box-summed volume when block_size > 1. Aggregation (Hirschmueller's recurrence): 5 paths in one
+pass from the top (_down); 8 paths as two directions that each store their sums for half the
+image (_sweep); 4 paths, the defaults, in blocks of K rows from a stored row of the path from
+the bottom every K rows, with no volume (_vertical, _four). Path costs, sums and penalties are
 uint16 with the disparity axis innermost, so every per-disparity loop runs in 16-bit lanes.
 
 Candidate j is disparity dmin + j; the left pixel x matches right pixel x - d. A candidate
@@ -13,6 +13,8 @@ whose right pixel falls outside the image costs the most a census can differ (CE
 """
 
 from __future__ import annotations
+
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit, prange, types
@@ -495,6 +497,151 @@ def _down(cl, crrev, vol, pl, prrev, term, S, P, M, crow, tot, y0, y1, warm, p1,
             S[y] = tot
 
 
+@njit(cache=True, fastmath=True)
+def _vertical(cl, crrev, vol, pl, prrev, term, forward, rows, K, ck, ckm, p1, p2, dmin):
+    """The path from the bottom (not forward: rows h - 1 up to h - rows) or from the top
+    (forward: rows 0 .. rows - 1) alone, keeping two rows of it. Going up, the path's row y is
+    stored in ck[y // K - 1] (ckm: its minima) at every y that is a multiple of K above 0
+    (the row below each block of the 4-path pass but the last); going down, its last row in
+    ck[0]. ck is uint8 where every path cost fits (_four_path_layout), else uint16."""
+    h, w = cl.shape
+    nd = ck.shape[2]
+    P = np.empty((2, w, nd + 2), dtype=np.uint16)
+    P[:, :, 0] = PAD
+    P[:, :, nd + 1] = PAD
+    M = np.empty((2, w), dtype=np.uint16)
+    crow = np.empty((w, nd), dtype=np.uint16)
+    for i in range(rows):
+        y = i if forward else h - 1 - i
+        _cost_row(cl, crrev, vol, pl, prrev, term, y, dmin, crow)
+        b = i % 2
+        for x in range(w):
+            if i == 0:
+                M[b, x] = _start(P[b, x], crow[x], nd)
+            else:
+                M[b, x] = _step(P[1 - b, x], M[1 - b, x], P[b, x], crow[x], p1, p2, nd)
+        if forward:
+            store = i == rows - 1
+            k = 0
+        else:
+            store = y > 0 and y % K == 0
+            k = y // K - 1
+        if store:
+            for x in range(w):
+                ckm[k, x] = M[b, x]
+                src = P[b, x]
+                dst = ck[k, x]
+                for j in range(nd):
+                    dst[j] = src[j + 1]
+
+
+@njit(cache=True, fastmath=True)
+def _four(cl, crrev, vol, pl, prrev, term, S, y0, y1, K, ck, ckm, top, topm, BB, CB, p1, p2,
+          dmin, uniqueness, fit, want_right, disp_l, disp_r, sh, keep):
+    """The 4-path pass (left, right, top, bottom) over rows y0 .. y1 - 1 in blocks of K rows,
+    without a volume: for each block, the path from the bottom is taken up through it again
+    from the stored row below it (ck, ckm: _vertical; at the image's last row it starts),
+    keeping its K rows (BB) and, where every cost fits in a byte, the block's cost rows (CB);
+    then the rows go down: the path from the top (two rows, carried from block to block; at
+    y0 > 0 it starts from top, topm: the path's row y0 - 1), the paths along the row as in
+    _down, the sum with the stored bottom row, the decision. Every path cost is the one a
+    whole-image pass gives, so the maps do not depend on K or on where a stripe starts.
+    """
+    h, w = cl.shape
+    nd = ck.shape[2]
+    idx = np.arange(nd + 1).astype(np.uint16)
+    jj = np.arange(nd + 1).astype(np.uint32)
+    fb = np.empty((4, w), dtype=np.float32)
+    mins = np.empty(w, dtype=np.uint16)
+    Z = np.zeros(nd + 2, dtype=np.uint16)
+    H = np.empty((2, nd + 2), dtype=np.uint16)
+    H[:, 0] = PAD
+    H[:, nd + 1] = PAD
+    P = np.empty((2, w, nd + 2), dtype=np.uint16)
+    P[:, :, 0] = PAD
+    P[:, :, nd + 1] = PAD
+    M = np.empty((2, w), dtype=np.uint16)
+    MB = np.empty((2, w), dtype=np.uint16)
+    below = np.empty(nd + 2, dtype=np.uint16)
+    below[0] = PAD
+    below[nd + 1] = PAD
+    crow = np.empty((w, nd), dtype=np.uint16)
+    tot = np.empty((w, nd), dtype=np.uint16)
+    acc = np.empty(w + nd, dtype=np.uint32)
+    acc16 = np.empty(w + nd, dtype=np.uint16)
+    BB[:, :, 0] = PAD
+    BB[:, :, nd + 1] = PAD
+    kept = CB.shape[0] > 0
+    if y0 > 0:
+        b = (y0 - 1) % 2
+        for x in range(w):
+            M[b, x] = topm[x]
+            src = top[x]
+            dst = P[b, x]
+            for j in range(nd):
+                dst[j + 1] = src[j]
+    for b0 in range(y0, y1, K):
+        b1 = min(b0 + K, y1)
+        for y in range(b1 - 1, b0 - 1, -1):
+            r = y - b0
+            _cost_row(cl, crrev, vol, pl, prrev, term, y, dmin, crow)
+            if kept:
+                for x in range(w):
+                    cx = CB[r, x]
+                    c = crow[x]
+                    for j in range(nd):
+                        cx[j] = np.uint8(c[j])
+            b = y % 2
+            for x in range(w):
+                c = crow[x]
+                dst = BB[r, x]
+                if y == h - 1:
+                    MB[b, x] = _start(dst, c, nd)
+                elif y == b1 - 1:
+                    src = ck[b1 // K - 1, x]
+                    for j in range(nd):
+                        below[j + 1] = src[j]
+                    MB[b, x] = _step(below, ckm[b1 // K - 1, x], dst, c, p1, p2, nd)
+                else:
+                    MB[b, x] = _step(BB[r + 1, x], MB[1 - b, x], dst, c, p1, p2, nd)
+        for y in range(b0, b1):
+            r = y - b0
+            if kept:
+                for x in range(w):
+                    cx = CB[r, x]
+                    c = crow[x]
+                    for j in range(nd):
+                        c[j] = np.uint16(cx[j])
+            else:
+                _cost_row(cl, crrev, vol, pl, prrev, term, y, dmin, crow)
+            b = y % 2
+            a = 1 - b
+            m0 = np.uint16(0)
+            for x in range(w):
+                c = crow[x]
+                v = P[b, x]
+                if y == 0:
+                    M[b, x] = _start(v, c, nd)
+                else:
+                    M[b, x] = _step(P[a, x], M[a, x], v, c, p1, p2, nd)
+                h0 = H[x % 2]
+                m0 = _start(h0, c, nd) if x == 0 else _step(H[1 - x % 2], m0, h0, c, p1, p2,
+                                                            nd)
+                _sum_into(tot[x], Z, h0, v, BB[r, x], Z, nd, False)
+            m4 = np.uint16(0)
+            for t in range(w):
+                x = w - 1 - t
+                c = crow[x]
+                h4 = H[t % 2]
+                m4 = _start(h4, c, nd) if t == 0 else _step(H[1 - t % 2], m4, h4, c, p1, p2,
+                                                            nd)
+                mins[x] = _sum_into(tot[x], tot[x], h4, Z, Z, Z, nd, True)
+            _decide_row(tot, mins, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc,
+                        acc16, sh, idx, jj, fb)
+            if keep:
+                S[y] = tot
+
+
 @njit(cache=True)
 def _buffers(n, w, nd):
     """n sets of the state one direction or stripe carries: rows of path costs P (2 row
@@ -513,7 +660,7 @@ def _buffers(n, w, nd):
 
 @njit(cache=True, parallel=True)
 def _match(cl, crrev, vol, pl, prrev, term, S, C, dmin, p1, p2, paths, uniqueness, fit,
-           want_right, keep):
+           want_right, keep, K, ck, ckm, top, topm, BB, CB):
     """Semi-global matching of census images cl and crrev (see _cost_row): disparity maps of
     the left and (want_right) right view in px, NaN where the uniqueness test rejects.
 
@@ -553,6 +700,27 @@ def _match(cl, crrev, vol, pl, prrev, term, S, C, dmin, p1, p2, paths, uniquenes
                   0 if k == 0 else min(OVERLAP, upper), p1, p2, dmin, uniqueness, fit,
                   want_right, disp_l, disp_r, acc[0], acc16[0], sh, keep)
         return disp_l, disp_r
+    if paths == 4:
+        # the path from the bottom alone first, storing its row below every block; with two
+        # stripes (BB holds two blocks) the path from the top meanwhile goes down to the
+        # lower stripe's first row
+        stripes = BB.shape[0]
+        nblocks = (h + K - 1) // K
+        mid = (nblocks + 1) // 2 * K if stripes == 2 else h
+        for k in prange(2):
+            if k == 0:
+                _vertical(cl, crrev, vol, pl, prrev, term, False, max(h - K, 0), K, ck, ckm,
+                          p1, p2, dmin)
+            elif stripes == 2:
+                _vertical(cl, crrev, vol, pl, prrev, term, True, mid, K, top, topm, p1, p2,
+                          dmin)
+        for k in prange(2):
+            if k < stripes:
+                y0, y1 = (0, mid) if k == 0 else (mid, h)
+                _four(cl, crrev, vol, pl, prrev, term, S, y0, y1, K, ck, ckm, top[0], topm[0],
+                      BB[k], CB[k], p1, p2, dmin, uniqueness, fit, want_right, disp_l, disp_r,
+                      sh, keep)
+        return disp_l, disp_r
     P, M, crow, tot, acc, acc16 = _buffers(2, w, nd)  # the directions go on from row to row
     diagonals = paths == 8
     for phase in range(2):
@@ -578,15 +746,77 @@ def census_term(outside: int = CENSUS_BITS) -> np.ndarray:
     return np.array([outside, 0, 0, 0, 0, max(CENSUS_BITS, outside)], dtype=np.int64)
 
 
-def match(cl, crrev, vol, S, dmin, p1, p2, paths, uniqueness, fit, want_right, keep,
-          pl=NO_PLANES, prrev=NO_PLANES, term=None, costs=NO_COSTS):
+def match(cl: np.ndarray, crrev: np.ndarray, vol: np.ndarray, S: np.ndarray, dmin: int,
+          p1: np.uint16, p2: np.uint16, paths: int, uniqueness: float, fit: int,
+          want_right: bool, keep: bool, pl: np.ndarray = NO_PLANES,
+          prrev: np.ndarray = NO_PLANES, term: np.ndarray | None = None,
+          costs: np.ndarray = NO_COSTS, four: FourPath | None = None
+          ) -> tuple[np.ndarray, np.ndarray]:
     """_match with the cost from vol, or (vol empty) from the census rows plus, where pl has
     channels, the intensity term of the planes pl and prrev (cost.reversed_planes) as
     term says (cost.integer_term; default: census alone, CENSUS_BITS outside the image).
-    costs: with 4 or 8 paths and every cost under 256, a (rows, cols, nd) uint8 buffer in which
-    each cost row is kept for the second direction (see _sweep), else NO_COSTS."""
-    return _match(cl, crrev, vol, pl, prrev, census_term() if term is None else term, S, costs,
-                  dmin, p1, p2, paths, uniqueness, fit, want_right, keep)
+    costs: with 8 paths and every cost under 256, a (rows, cols, nd) uint8 buffer in which
+    each cost row is kept for the second direction (see _sweep), else NO_COSTS.
+    four: the 4-path buffers (FourPath; made here for one stripe when not given).
+    S: (rows, cols, nd) with 8 paths or keep (the totals are left in it), else (0, 0, nd)."""
+    term = census_term() if term is None else term
+    h, w = cl.shape
+    nd = S.shape[2]
+    if four is None:
+        four = FourPath.make(h, w, nd, largest_cost(vol, term), int(p2), vol.shape[0] == 0,
+                             1 if paths == 4 else 0)
+    disp_l: np.ndarray
+    disp_r: np.ndarray
+    disp_l, disp_r = _match(cl, crrev, vol, pl, prrev, term, S, costs, dmin, p1, p2, paths,
+                            uniqueness, fit, want_right, keep, four.K, four.ck, four.ckm,
+                            four.top, four.topm, four.BB, four.CB)
+    return disp_l, disp_r
+
+
+def largest_cost(vol: np.ndarray, term: np.ndarray) -> int:
+    """The largest cost a row can hold: the volume's largest, or term's (_cost_row)."""
+    return int(vol.max()) if vol.shape[0] else int(term[5])
+
+
+class FourPath(NamedTuple):
+    """The 4-path pass's memory (_match, _vertical, _four): the bottom path's row below each
+    block of K rows (ck, its minima ckm), the top path's row above the lower stripe (top,
+    topm; two stripes only), and per stripe one block's bottom path rows (BB) and cost rows
+    (CB, uint8; empty where a cost can reach 256 or a volume holds the costs). top is one row
+    with one stripe too (not used: a row of memory against an empty view's index)."""
+    K: int
+    ck: np.ndarray
+    ckm: np.ndarray
+    top: np.ndarray
+    topm: np.ndarray
+    BB: np.ndarray
+    CB: np.ndarray
+
+    @staticmethod
+    def make(h: int, w: int, nd: int, cmax: int, p2: int, rows_made: bool,
+             stripes: int, K: int | None = None) -> FourPath:
+        """Buffers for rows x cols x nd with costs up to cmax and penalty p2 (no path cost
+        exceeds cmax + p2: a step adds a cost to at most the previous minimum + P2, less that
+        minimum); stripes 0 gives empty ones (5 or 8 paths). K: the block's rows (default:
+        the least memory, block_rows)."""
+        small = cmax + p2 <= 0xFF
+        keep_costs = rows_made and cmax <= 0xFF
+        K = K or block_rows(h, 1 if small else 2, 1 if keep_costs else 0)
+        nck = (h + K - 1) // K - 1 if stripes else 0
+        cdt = np.uint8 if small or not stripes else np.uint16
+        n = stripes
+        return FourPath(K, np.empty((nck, w, nd), cdt), np.empty((nck, w), np.uint16),
+                        np.empty((1 if n else 0, w, nd), cdt), np.empty((1 if n else 0, w),
+                                                                         np.uint16),
+                        np.empty((n, K if n else 0, w, nd + 2), np.uint16),
+                        np.empty((n, K if n and keep_costs else 0, w, nd), np.uint8))
+
+
+def block_rows(h: int, ck_bytes: int, cost_bytes: int) -> int:
+    """Rows K of a 4-path block with the least memory: ceil(h / K) - 1 stored rows of ck_bytes
+    a cost and K of 2 + cost_bytes (bottom path, kept cost)."""
+    return min(range(1, h + 1),
+               key=lambda k: ((h + k - 1) // k - 1) * ck_bytes + k * (2 + cost_bytes))
 
 
 def reversed_right(cr: np.ndarray, dmin: int, nd: int) -> np.ndarray:

@@ -14,6 +14,7 @@ import pytest
 
 from host.errors import HostError
 from host.stereo import MatcherParams, compute_disparity, evaluate, load_scene, sgm
+from host.stereo.matcher import numba_threads
 from host.stereo.synthetic import Layer, random_texture, render_pair, synthetic_scene
 from tests.stereo import sgm_reference
 
@@ -237,6 +238,45 @@ def test_sgm_maps_equal_the_reference_written_before_the_speed_rework(i: int) ->
     np.testing.assert_array_equal(right, sgm_reference.unpack(stored[f"right{i}"]))
 
 
+@pytest.mark.parametrize("stripes", [1, 2])
+@pytest.mark.parametrize("K", [1, 2, 5, 13])
+@pytest.mark.parametrize("top", [60, 300])
+def test_four_path_blocks_and_stripes_give_the_whole_image_totals(K, stripes, top) -> None:
+    # the 4-path pass keeps no volume: the path from the bottom is stored every K rows (uint8
+    # where every path cost fits, top 60 + P2 30; uint16 at 300) and taken up through each
+    # block again; with two stripes the lower one starts from the path from the top's row
+    # above it. Whatever K and the stripes, the totals are those of the plain recurrence
+    cost = np.random.default_rng(K).integers(0, top, (13, 9, 20)).astype(np.uint16)
+    h, w, nd = cost.shape
+    none = np.zeros((h, w), np.uint64)
+    total = np.empty_like(cost)
+    four = sgm.FourPath.make(h, w, nd, int(cost.max()), 30, False, stripes, K)
+    with numba_threads(stripes):
+        left, right = sgm.match(none, sgm.reversed_right(none, 0, nd), cost, total, 0,
+                                np.uint16(7), np.uint16(30), 4, 0.0, 0, True, True, four=four)
+    want = _naive_paths(cost, 7, 30, FOUR)
+    np.testing.assert_array_equal(total, want)
+    np.testing.assert_array_equal(left, np.argmin(want, axis=2).astype(np.float32))
+
+
+@pytest.mark.parametrize("stripes", [1, 2])
+@pytest.mark.parametrize("K", [1, 7, 60])
+def test_four_path_blocks_on_census_rows_equal_the_reference(K, stripes) -> None:
+    # the same from census rows (each block's cost rows kept as bytes), against the maps of
+    # sgm_reference.npz (written at 711cc8e, when the 4-path scheme kept a whole sum volume)
+    i = sgm_reference.CONFIGS.index((4, 0, 30, 0, 5.0, 2, 11, 60))
+    stored = np.load(sgm_reference.FILE)
+    cl, cr = (sgm_reference.census(v) for v in sgm_reference.images())
+    h, w = cl.shape
+    four = sgm.FourPath.make(h, w, 30, sgm.CENSUS_BITS, 60, True, stripes, K)
+    with numba_threads(stripes):
+        left, right = sgm.match(cl, sgm.reversed_right(cr, 0, 30), sgm.NO_VOLUME,
+                                np.empty((0, 0, 30), np.uint16), 0, np.uint16(11),
+                                np.uint16(60), 4, 5.0, 2, True, False, four=four)
+    np.testing.assert_array_equal(left, sgm_reference.unpack(stored[f"left{i}"]))
+    np.testing.assert_array_equal(right, sgm_reference.unpack(stored[f"right{i}"]))
+
+
 FAULTS = """
 import resource, sys
 import numpy as np
@@ -244,9 +284,10 @@ from host.stereo import MatcherParams, compute_disparity
 rng = np.random.default_rng(3)
 wide = rng.integers(0, 256, (480, 700), dtype=np.uint8)
 left, right = np.ascontiguousarray(wide[:, :640]), np.ascontiguousarray(wide[:, 20:660])
-for paths in (5, 8):
+for paths in (5, 8, 0):
     p = MatcherParams(matcher="sgm", block_size=1, border="clip", num_disparities=64,
-                      lr_check=1.0, fill=True, paths=paths)
+                      lr_check=1.0, fill=True, paths=paths) if paths else (
+        MatcherParams.for_matcher("sgm").replace(num_disparities=64))  # the defaults: 4 paths
     for _ in range(3):
         compute_disparity(left, right, p)
     before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
@@ -262,4 +303,4 @@ def test_sgm_in_steady_state_takes_no_page_faults() -> None:
     # takes without it depends on what the process freed before (glibc's thresholds adapt)
     out = subprocess.run([sys.executable, "-c", FAULTS], capture_output=True, text=True,
                          check=True, timeout=600).stdout.split()
-    assert [float(v) for v in out] == [0.0, 0.0], f"minor page faults per call: {out}"
+    assert [float(v) for v in out] == [0.0, 0.0, 0.0], f"minor page faults per call: {out}"
