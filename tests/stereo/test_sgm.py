@@ -303,4 +303,7 @@ def test_sgm_in_steady_state_takes_no_page_faults() -> None:
     # takes without it depends on what the process freed before (glibc's thresholds adapt)
     out = subprocess.run([sys.executable, "-c", FAULTS], capture_output=True, text=True,
                          check=True, timeout=600).stdout.split()
-    assert [float(v) for v in out] == [0.0, 0.0, 0.0], f"minor page faults per call: {out}"
+    # below one a call: now and then a single stray fault comes from outside the matcher (seen
+    # once in about 30 calls of the defaults, with one thread too: the interpreter's own arenas);
+    # a buffer that is not kept costs thousands a call
+    assert all(float(v) < 1.0 for v in out), f"minor page faults per call: {out}"
