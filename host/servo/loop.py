@@ -44,6 +44,9 @@ from host.servo.perception import (
     StripMap,
     Target,
     fit_floor,
+    fixed_cells,
+    fixed_in_path,
+    in_view,
     lane_obstacle,
     lane_window,
     match_exposure,
@@ -96,6 +99,8 @@ class ServoConfig:
     moved_rows: float = 0.005  # of the focal length (0.3 degrees of pitch): the camera moved
     acquire_tries: int = 3  # look-alikes that do not move, left out one after the other
     lane_width_px: int = 320  # the lane is watched on frames scaled down to about this width
+    ring_ratio: float = 1.7  # the marker's light ring, in disc radii (as printed: marker.py)
+    react_s: float = 0.33  # a command's reaction and the wheels' run-down (the view's check)
     timing: TimingConfig = field(default_factory=TimingConfig)
     estimator: EstimatorConfig = field(default_factory=EstimatorConfig)
     acquire: AcquireConfig = field(default_factory=AcquireConfig)
@@ -254,6 +259,8 @@ class Servo:
         self.controller = Controller(self.geometry.depth_m(target.disparity), self.control)
         self.controller.keep_out = self._extent(
             object_extent(without_floor(self.reference_map, self.floor), target))
+        self.controller.fixed = fixed_cells(self.reference_map, self.geometry,
+                                            self.control.cell_m)
         return target
 
     def _lane_map(self, reference: np.ndarray) -> np.ndarray:
@@ -449,6 +456,38 @@ class Servo:
         if found is None:
             return ""
         return f"an object in the lane {found.ahead_m:.2f} m ahead"
+
+    def _path_fault(self, frame: StereoFrame, cmd: Command) -> str:
+        """Why the command must not be sent and the run ends, or "": the marker's ring would
+        leave the picture before a stop acts (the robot at the picture's edge, or near the
+        camera; a probe may go either way), or a fixed object of the reference stands where
+        the body goes within its stopping distance (the lane steers clear of them, this is
+        the backstop)."""
+        est, c = self.estimator, self.controller
+        if est.state is None or c is None:
+            return ""
+        z, x = est.state.z, est.state.x
+        toward = cmd.phase == "probe" or c.target_m < z
+        pair = self.last_pair
+        if pair is not None:
+            h, w = frame.left.shape[:2]
+            run = abs(est.state.vz) * self.cfg.react_s + 0.02
+            scale = z / max(z - run, 0.2) if toward else 1.0
+            g = self.geometry
+            if not in_view(pair.left.u, pair.left.v, pair.left.radius * self.cfg.ring_ratio,
+                           (w, h), scale, g.cx, g.cy):
+                return "the marker would leave the view: the robot is at the picture's edge"
+        duty = abs(cmd.left + cmd.right) / 2
+        speed = max(abs(est.state.vz), est.cfg.max_speed_mps * duty / 1000)
+        reach = stopping_distance_m(speed) + self.cfg.lane_margin_m
+        ways = (1, -1) if cmd.phase == "probe" else ((-1,) if c.target_m < z else (1,))
+        cfg = c.cfg
+        for way in ways:
+            ahead = fixed_in_path(c.others(), z, x, way, reach,
+                                  cfg.half_width_m + cfg.block_margin_m / 2, cfg.cell_m)
+            if ahead is not None:
+                return f"a fixed object stands in the robot's path {ahead:.2f} m ahead"
+        return ""
 
     # -------------------------------------------------------------------- acquisition
 
@@ -658,6 +697,7 @@ class Servo:
         c = Controller(old.target_m, self.control)
         c.cfg, c.keep_out, c.trim, c.facing_away = old.cfg, old.keep_out, old.trim, \
             old.facing_away
+        c.fixed = old.fixed
         self.controller = c
         self._cmd = Command(0, 0, "wait", None)
         self.notes.append(f"recovered ({why}): re-acquiring the robot")
@@ -713,6 +753,7 @@ class Servo:
         self.controller.target_m = self.geometry.depth_m(target.disparity)
         self.controller.keep_out = self._extent(
             object_extent(without_floor(reference, floor), target))
+        self.controller.fixed = fixed_cells(reference, self.geometry, self.control.cell_m)
         assert self._strips is not None
         self._strips.reset()
         self._remeasure_t = None
@@ -753,6 +794,11 @@ class Servo:
         while; the controller learns that it stood (its creep floor must not rise)."""
         assert self.controller is not None
         moving = not cmd.is_stop and cmd.phase in ("drive", "creep", "probe")
+        fault = self._path_fault(frame, cmd) if moving else ""
+        if fault:  # nothing to wait for: the run ends here
+            self.stop_reason = self.stop_reason or fault
+            self.controller.phase = "stop"
+            return Command(0, 0, "stop", cmd.error_m), invalid
         blocked = self._lane_blocked(frame, cmd) if moving else ""
         rec = self.recovery
         if blocked:

@@ -440,3 +440,70 @@ def lane_obstacle(disp: np.ndarray, geometry: Geometry, depth_m: float, lateral_
     if area < max(25.0, (min_size_m * g.focal_px / zm) ** 2):
         return None
     return LaneObstacle(zm, (zm - depth_m) * direction, area)
+
+
+def fixed_cells(disp: np.ndarray, geometry: Geometry, cell_m: float = 0.02,
+                min_height_m: float = 0.05, floor_clear_m: float = 0.03, height_m: float = 0.30,
+                camera_height_m: float = 0.25) -> np.ndarray:
+    """Where the scene's fixed objects stand, seen from above: the (depth, lateral) centres (m)
+    of the cell_m x cell_m floor cells that hold an upright face, as an (n, 2) array. A cell's
+    points are those of the map between floor_clear_m and height_m above the floor (the
+    robot's height; the floor is never an object); it holds a face when they rise at least
+    min_height_m, span two image columns or more, and number at least half of what a face
+    cell_m wide and min_height_m tall at that depth shows. disp: the reference map (the scene
+    without the robot, px, NaN invalid). A box's front face fills each cell it stands on with
+    hundreds of points; a mismatch (the near floor beyond the search range, the first valid
+    column) puts a few dozen in a small patch or a single column. The target is among them
+    (the controller leaves its extent to the keep-out)."""
+    g = geometry
+    with np.errstate(invalid="ignore"):
+        vs, us = np.nonzero(np.isfinite(disp) & (disp > 0.5))
+    d = disp[vs, us].astype(np.float64)
+    y = camera_height_m - g.baseline_m * (vs - g.cy) / d
+    keep = (y > floor_clear_m) & (y < height_m)
+    d, y, u = d[keep], y[keep], us[keep]
+    if d.size == 0:
+        return np.zeros((0, 2))
+    z = g.focal_px * g.baseline_m / d
+    x = g.baseline_m * (u - g.cx) / d
+    cells = np.stack([np.floor(z / cell_m), np.floor(x / cell_m)], axis=1).astype(np.int64)
+    found, which, counts = np.unique(cells, axis=0, return_inverse=True, return_counts=True)
+    which = which.ravel()
+    n = len(found)
+    y_lo, y_hi = np.full(n, np.inf), np.full(n, -np.inf)
+    u_lo, u_hi = np.full(n, np.inf), np.full(n, -np.inf)
+    np.minimum.at(y_lo, which, y)
+    np.maximum.at(y_hi, which, y)
+    np.minimum.at(u_lo, which, u)
+    np.maximum.at(u_hi, which, u)
+    zc = (found[:, 0] + 0.5) * cell_m
+    face = 0.5 * (g.focal_px * cell_m / zc) * (g.focal_px * min_height_m / zc)
+    ok = (y_hi - y_lo >= min_height_m) & (u_hi - u_lo >= 1) & (counts >= face)
+    return (found[ok] + 0.5) * cell_m
+
+
+def fixed_in_path(cells: np.ndarray, depth_m: float, lateral_m: float, direction: int,
+                  reach_m: float, half_width_m: float, cell_m: float = 0.02,
+                  body_m: float = 0.10) -> float | None:
+    """How far ahead (m, from the robot's centre) the nearest of a fixed object's floor cells
+    (fixed_cells) stands in the stretch the robot's body (half_width_m each side of its line
+    at lateral_m) sweeps within body_m + reach_m ahead (direction +1: away from the camera,
+    -1: toward it); None when the stretch is clear."""
+    if not len(cells):
+        return None
+    ahead = (cells[:, 0] - depth_m) * direction
+    hit = (ahead >= 0) & (ahead <= body_m + reach_m) & (
+        np.abs(cells[:, 1] - lateral_m) < half_width_m + cell_m / 2)
+    return float(ahead[hit].min()) if hit.any() else None
+
+
+def in_view(u: float, v: float, ring_px: float, size: tuple[int, int], scale: float = 1.0,
+            cx: float | None = None, cy: float | None = None, margin_px: float = 2.0) -> bool:
+    """Whether the marker's whole ring (centre u, v and radius ring_px in the left image) stays
+    inside the picture, by margin_px, once the robot's depth has shrunk by the factor 1/scale
+    (scale > 1: nearer the camera; image offsets from the centre cx, cy and sizes grow by it)."""
+    w, h = size
+    cx = (w - 1) / 2 if cx is None else cx
+    cy = (h - 1) / 2 if cy is None else cy
+    u2, v2, r2 = cx + (u - cx) * scale, cy + (v - cy) * scale, ring_px * scale + margin_px
+    return r2 <= u2 <= w - 1 - r2 and r2 <= v2 <= h - 1 - r2
