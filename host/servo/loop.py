@@ -460,9 +460,9 @@ class Servo:
     def _path_fault(self, frame: StereoFrame, cmd: Command) -> str:
         """Why the command must not be sent and the run ends, or "": the marker's ring would
         leave the picture before a stop acts (the robot at the picture's edge, or near the
-        camera; a probe may go either way), or a fixed object of the reference stands where
-        the body goes within its stopping distance (the lane steers clear of them, this is
-        the backstop)."""
+        camera; a probe may go either way), or, driving toward the target, a fixed object of
+        the reference stands where the body goes within its stopping distance (the lane
+        steers clear of them, this is the backstop)."""
         est, c = self.estimator, self.controller
         if est.state is None or c is None:
             return ""
@@ -480,13 +480,13 @@ class Servo:
         duty = abs(cmd.left + cmd.right) / 2
         speed = max(abs(est.state.vz), est.cfg.max_speed_mps * duty / 1000)
         reach = stopping_distance_m(speed) + self.cfg.lane_margin_m
-        ways = (1, -1) if cmd.phase == "probe" else ((-1,) if c.target_m < z else (1,))
+        if cmd.phase == "probe":  # a sighting not yet trusted (maybe a look-alike standing
+            return ""  # in the reference, its own body a fixed object); the probe is short
         cfg = c.cfg
-        for way in ways:
-            ahead = fixed_in_path(c.others(), z, x, way, reach,
-                                  cfg.half_width_m + cfg.block_margin_m / 2, cfg.cell_m)
-            if ahead is not None:
-                return f"a fixed object stands in the robot's path {ahead:.2f} m ahead"
+        ahead = fixed_in_path(c.others(), z, x, -1 if c.target_m < z else 1, reach,
+                              cfg.half_width_m + cfg.block_margin_m / 2, cfg.cell_m)
+        if ahead is not None:
+            return f"a fixed object stands in the robot's path {ahead:.2f} m ahead"
         return ""
 
     # -------------------------------------------------------------------- acquisition

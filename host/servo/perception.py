@@ -484,15 +484,18 @@ def fixed_cells(disp: np.ndarray, geometry: Geometry, cell_m: float = 0.02,
 
 def fixed_in_path(cells: np.ndarray, depth_m: float, lateral_m: float, direction: int,
                   reach_m: float, half_width_m: float, cell_m: float = 0.02,
-                  body_m: float = 0.10) -> float | None:
+                  body_m: float = 0.10, own_m: float = 0.06) -> float | None:
     """How far ahead (m, from the robot's centre) the nearest of a fixed object's floor cells
     (fixed_cells) stands in the stretch the robot's body (half_width_m each side of its line
     at lateral_m) sweeps within body_m + reach_m ahead (direction +1: away from the camera,
-    -1: toward it); None when the stretch is clear."""
+    -1: toward it); None when the stretch is clear. A cell within own_m of the robot's
+    centre is where the robot itself stands: a fixed object there means the sighting is of
+    it (another robot's card, standing in the reference), which the acquisition's probe
+    finds out, not an obstacle."""
     if not len(cells):
         return None
     ahead = (cells[:, 0] - depth_m) * direction
-    hit = (ahead >= 0) & (ahead <= body_m + reach_m) & (
+    hit = (ahead >= own_m) & (ahead <= body_m + reach_m) & (
         np.abs(cells[:, 1] - lateral_m) < half_width_m + cell_m / 2)
     return float(ahead[hit].min()) if hit.any() else None
 

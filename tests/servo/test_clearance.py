@@ -192,3 +192,16 @@ def test_a_robot_pushed_toward_the_object_while_its_card_is_unseen_stops_the_run
         ctl.update(Observation(t, 1.2 if seen else None, x if seen else None))
     assert ctl.fault == PUSHED
     assert x - ctl.cfg.half_width_m > BOX[1] + 0.01
+
+
+def test_a_look_alike_where_the_robot_stands_does_not_block_its_turn() -> None:
+    """Fixed cells inside the body itself (a decoy robot that stood in the reference, where
+    the sighting says the robot is) are no obstacle to the turn; one 10 cm beside it is."""
+    own = Controller(1.2, ControlConfig())
+    own.keep_out = BOX
+    own.fixed = np.array([[1.49, 0.01], [1.47, -0.01]])
+    assert own.update(Observation(0.0, 1.5, 0.0)).phase == "turn"
+    beside = Controller(1.2, ControlConfig())
+    beside.keep_out = BOX
+    beside.fixed = np.array([[1.49, 0.11]])
+    assert beside.update(Observation(0.0, 1.5, 0.0)).is_stop and beside.fault == TURN_BLOCKED

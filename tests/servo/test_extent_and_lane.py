@@ -187,6 +187,9 @@ def test_fixed_in_path_sees_a_cell_where_the_body_goes_within_reach() -> None:
     assert fixed_in_path(cells, 2.2, 0.15, -1, 0.2, 0.09) is None  # beyond reach
     assert fixed_in_path(cells, 2.2, 0.10, -1, 0.4, 0.09) is None  # clear of its side
     assert fixed_in_path(cells, 2.2, 0.15, 1, 0.4, 0.09) is None  # behind the robot
+    # a cell where the robot stands is not in its way: the sighting is of a look-alike that
+    # stood in the reference (seed 8 trial 45: a decoy robot's body, "0.00 m ahead")
+    assert fixed_in_path(cells, 1.83, 0.24, -1, 0.4, 0.09) is None
 
 
 def test_in_view_wants_the_whole_ring_inside_after_the_run_toward_the_camera() -> None:
