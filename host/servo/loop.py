@@ -25,6 +25,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import cv2
 import numpy as np
@@ -32,7 +33,7 @@ import numpy as np
 from host.camera.geometry import Geometry
 from host.camera.source import CameraError, StereoFrame, StereoSource
 from host.errors import HostError
-from host.link.client import RobotReset
+from host.link.client import RobotLink, RobotReset
 from host.servo.acquire import NOT_MOVED, AcquireConfig, Acquisition
 from host.servo.controller import Command, ControlConfig, Controller, Observation
 from host.servo.deflicker import deflickered
@@ -151,9 +152,10 @@ class _Seen:
 
 
 class Servo:
-    def __init__(self, source: StereoSource, link, params: MatcherParams, geometry: Geometry,
-                 control: ControlConfig = ControlConfig(), config: ServoConfig | None = None,
-                 clock: Callable[[], float] = time.monotonic, **overrides) -> None:
+    def __init__(self, source: StereoSource, link: RobotLink, params: MatcherParams,
+                 geometry: Geometry, control: ControlConfig = ControlConfig(),
+                 config: ServoConfig | None = None,
+                 clock: Callable[[], float] = time.monotonic, **overrides: Any) -> None:
         """overrides: fields of ServoConfig (marker=, marker_radius_m=, full_map= ...)."""
         self.cfg = dataclasses.replace(config or ServoConfig(), **overrides)
         self.source, self.link, self.params = source, link, params
@@ -225,8 +227,9 @@ class Servo:
         "stop", and the caller's loop ends there."""
         self.requested_stop = self.stop_reason = reason
 
-    def _notify(self, frame: StereoFrame, phase: str, reason: str, disp, y0: int,
-                pair: MarkerPair | None, row, rtt_ms: float = math.nan) -> None:
+    def _notify(self, frame: StereoFrame, phase: str, reason: str, disp: np.ndarray | None,
+                y0: int, pair: MarkerPair | None, row: LogRow | None,
+                rtt_ms: float = math.nan) -> None:
         if self.observers:
             snap = Snapshot(self.clock(), phase, reason, frame.left, disp, y0, self.target, pair,
                             row, link_stats(self.link, rtt_ms), self.geometry)
@@ -362,7 +365,8 @@ class Servo:
 
     # ---------------------------------------------------------------------- the target
 
-    def _robot_region(self, pair: MarkerPair, shape: tuple[int, ...]) -> tuple[int, ...]:
+    def _robot_region(self, pair: MarkerPair, shape: tuple[int, ...]
+                      ) -> tuple[int, int, int, int]:
         """Image box (x0, y0, x1, y1) the robot may cover, from its marker."""
         ppm = pair.disparity / self.geometry.baseline_m
         h, w = shape[:2]
@@ -635,7 +639,7 @@ class Servo:
             cmd = self._acquire(t, position, d)
             return Command(0, 0, "stop", None) if self.stop_reason else cmd
         self._check_motion(t, position is not None)
-        if self.stop_reason:
+        if self._must_stop():  # the motion check may have ended the run
             return Command(0, 0, "stop", None)
         depth, lateral = position if position is not None else (None, None)
         aspect = pair.left.aspect if pair is not None else 1.0
@@ -643,6 +647,9 @@ class Servo:
         if self.controller.fault:  # it cannot go on: the run ends here
             self.stop_reason = self.controller.fault
         return cmd
+
+    def _must_stop(self) -> bool:
+        return bool(self.stop_reason)
 
     def _send(self, cmd: Command, t: float = math.nan) -> None:
         """The command over the link. A reset the link learns of (it has said HELLO again,

@@ -110,7 +110,7 @@ def nearest_object(disp: np.ndarray, min_area: int, step: float = 0.5,
     while level > step:
         levels.append(level)
         level -= step
-    seen: dict[int, tuple] = {}
+    seen: dict[int, tuple[int, np.ndarray, np.ndarray]] = {}
 
     def reaches(k: int) -> bool:
         if k not in seen:
@@ -152,7 +152,7 @@ def median_map(disps: list[np.ndarray]) -> np.ndarray:
     stack = np.stack(disps)
     with np.errstate(all="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # pixels invalid in every map stay NaN
-        return np.nanmedian(stack, axis=0) if len(disps) > 1 else stack[0]
+        return np.asarray(np.nanmedian(stack, axis=0)) if len(disps) > 1 else stack[0]
 
 
 def reference_target(disps: list[np.ndarray], min_area: int) -> tuple[Target, Floor | None]:
@@ -264,7 +264,7 @@ def object_extent(disp: np.ndarray, target: Target, tol_px: float | None = None,
         near = np.abs(disp - d) <= tol
     cols = near[y:y + bh].mean(axis=0) >= share
     x0, x1 = _run_through(cols, x, x + bw - 1, gap_px)
-    if x0 is None:
+    if x0 is None or x1 is None:
         return target
     valid_cols = np.flatnonzero(np.isfinite(disp[y:y + bh]).any(axis=0))
     if valid_cols.size and x0 <= valid_cols[0] + 1:
@@ -272,9 +272,8 @@ def object_extent(disp: np.ndarray, target: Target, tol_px: float | None = None,
     if valid_cols.size and x1 >= valid_cols[-1] - 1:
         x1 = w - 1
     rows = near[:, x0:x1 + 1].mean(axis=1) >= share
-    y0, y1 = _run_through(rows, y, y + bh - 1, gap_px)
-    if y0 is None:
-        y0, y1 = y, y + bh - 1
+    y0_, y1_ = _run_through(rows, y, y + bh - 1, gap_px)
+    y0, y1 = (y, y + bh - 1) if y0_ is None or y1_ is None else (y0_, y1_)
     area = int(near[y0:y1 + 1, x0:x1 + 1].sum())
     return Target(d, area, (int(x0), int(y0), int(x1 - x0 + 1), int(y1 - y0 + 1)),
                   target.spread)
@@ -479,7 +478,7 @@ def fixed_cells(disp: np.ndarray, geometry: Geometry, cell_m: float = 0.02,
     zc = (found[:, 0] + 0.5) * cell_m
     face = 0.5 * (g.focal_px * cell_m / zc) * (g.focal_px * min_height_m / zc)
     ok = (y_hi - y_lo >= min_height_m) & (u_hi - u_lo >= 1) & (counts >= face)
-    return (found[ok] + 0.5) * cell_m
+    return np.asarray((found[ok] + 0.5) * cell_m, np.float64)
 
 
 def fixed_in_path(cells: np.ndarray, depth_m: float, lateral_m: float, direction: int,
