@@ -47,6 +47,7 @@ WAIT, HOLD, DRIVE, CREEP, TURN, LOST, STALE, SEARCH, BLOCKED = (
     "wait", "hold", "drive", "creep", "turn", "lost", "stale", "search", "blocked")
 LINE_BLOCKED = "the robot's line passes through the object"
 PUSHED = "pushed sideways onto the object while holding"
+DRIFTED = "drifting sideways onto the object while the marker is unseen"
 TURN_BLOCKED = "turning here would sweep the robot's body into the object"
 
 
@@ -229,11 +230,18 @@ class Controller:
         """Standing beside the object (holding, or the marker missing since): a sideways drift
         that brings the body within block_margin_m of it within push_horizon_s (or has
         already, where the marker was last seen and the drift has taken it since)."""
-        cfg, fit = self.cfg, self.drift()
-        if self.keep_out is None or fit is None:
+        fit = self.drift()
+        if fit is None:
             return False
         t0, lateral, rate = fit
-        lateral += rate * (t - t0)
+        return self.closing(lateral + rate * (t - t0), rate)
+
+    def closing(self, lateral: float, rate: float) -> bool:
+        """Whether a body at this lateral position, drifting sideways at this rate (m/s), is
+        within block_margin_m of the object's extent or comes so within push_horizon_s."""
+        cfg = self.cfg
+        if self.keep_out is None:
+            return False
         if self.overlaps(lateral, cfg.block_margin_m):
             return True
         x0, x1 = self.keep_out

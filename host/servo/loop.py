@@ -35,7 +35,14 @@ from host.camera.source import CameraError, StereoFrame, StereoSource
 from host.errors import HostError
 from host.link.client import RobotLink, RobotReset
 from host.servo.acquire import NOT_MOVED, AcquireConfig, Acquisition
-from host.servo.controller import Command, ControlConfig, Controller, Observation
+from host.servo.controller import (
+    DRIFTED,
+    TURN_BLOCKED,
+    Command,
+    ControlConfig,
+    Controller,
+    Observation,
+)
 from host.servo.deflicker import deflickered
 from host.servo.estimator import AGAINST, OUTSIDE, STILL, Estimator, EstimatorConfig, Sighting
 from host.servo.inputs import FrozenSensors, camera_moved, views_agree
@@ -461,6 +468,23 @@ class Servo:
             return ""
         return f"an object in the lane {found.ahead_m:.2f} m ahead"
 
+    def _spin_fault(self, t: float, cmd: Command) -> str:
+        """Standing or spinning to find the card (the acquisition's, the search after a turn,
+        a wait for the marker) where the robot was last known to be beside the object: a spin
+        that sweeps its body into the object (controller.sweeps; the turn's own check is the
+        controller's), or, the card unseen, the sideways drift it last had (a push, a slope)
+        bringing it onto the object (controller.closing): why the run ends, or ""."""
+        est, c = self.estimator, self.controller
+        if est.state is None or c is None or abs(est.state.z - c.target_m) >= c.cfg.block_m:
+            return ""
+        s = est.state
+        if not cmd.is_stop and cmd.phase in ("find", "search") and c.sweeps(s.z, s.x):
+            return TURN_BLOCKED
+        # unseen for a few frames (seen, the controller's hold watches the drift itself)
+        if t - s.t > 0.1 and c.closing(s.x + s.vx * (t - s.t), s.vx):
+            return DRIFTED
+        return ""
+
     def _path_fault(self, frame: StereoFrame, cmd: Command) -> str:
         """Why the command must not be sent and the run ends, or "": the marker's ring would
         leave the picture before a stop acts (the robot at the picture's edge, or near the
@@ -801,7 +825,7 @@ class Servo:
         while; the controller learns that it stood (its creep floor must not rise)."""
         assert self.controller is not None
         moving = not cmd.is_stop and cmd.phase in ("drive", "creep", "probe")
-        fault = self._path_fault(frame, cmd) if moving else ""
+        fault = self._path_fault(frame, cmd) if moving else self._spin_fault(frame.t_left, cmd)
         if fault:  # nothing to wait for: the run ends here
             self.stop_reason = self.stop_reason or fault
             self.controller.phase = "stop"

@@ -3,12 +3,14 @@ between the robot and its target (not the target) is passed clear of, not driven
 trials 273 and 746 drove into the box at 1.8 m on their way to the target at 1.2-1.4 m: the
 lane kept clear of the target alone, and the lane watch takes what the reference showed for
 "not new"); a robot whose card is at the picture's edge is not driven out of the view (seed 8
-trials 519 and 935: the probe move drove with the ring already cut by the edge)."""
+trials 519 and 935: the probe move drove with the ring already cut by the edge); a robot
+pushed toward the object while its card is hidden stops before it reaches it."""
 
 from __future__ import annotations
 
 import math
 
+from host.sim.faults import Event, MotorFaults, WorldFaults
 from host.sim.run import Setup, simulation
 from host.sim.trials import _unsafe
 
@@ -54,3 +56,15 @@ def test_a_card_at_the_pictures_edge_is_not_driven_out_of_view() -> None:
     kind, why, _ = _run(Setup(start_z_m=0.47, start_x_m=0.15,
                               start_theta=math.pi + math.radians(20), seed=3), 25.0)
     assert kind in ("held", "stopped"), why
+
+
+def test_a_robot_pushed_beside_the_object_while_its_card_is_hidden_stops_the_run() -> None:
+    """Started 5 cm behind the object's face, its body 6 cm from the object's side, pushed
+    sideways toward the object (8 mm/s: a slope) while a post hides its card for 14 s (dev
+    seed 101 trial 75: the acquisition waited and spun for 10 s unseen while the push took it
+    into the box). The drift the estimator had before the card went brings the body onto the
+    object within the push horizon: the run ends with the reason before it gets there."""
+    faults = WorldFaults(motor=MotorFaults(push_mps=-0.008),
+                         events=(Event(1.0, "occlude", fraction=1.0, duration_s=14.0),))
+    kind, why, _ = _run(Setup(start_z_m=1.25, start_x_m=-0.04, faults=faults, seed=3), 20.0)
+    assert kind == "stopped", why
