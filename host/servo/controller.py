@@ -74,7 +74,7 @@ class ControlConfig:
     turn_radius_m: float = 0.115  # a turn in place sweeps this circle: half the body's diagonal
     path_margin_m: float = 0.10  # fixed objects this far beyond the target's depth are in its path
     cell_m: float = 0.02  # the fixed objects' floor cells (perception.fixed_cells)
-    push_horizon_s: float = 6.0  # standing, a sideways drift that would bring the body onto
+    push_horizon_s: float = 3.0  # standing, a sideways drift that would bring the body onto
     # the object within this long ends the run (it cannot move sideways in place)
     drift_s: float = 3.0  # the sideways drift beside the object is fitted over this long
     mode: str = "turn"  # or "reverse"
