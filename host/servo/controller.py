@@ -77,6 +77,8 @@ class ControlConfig:
     push_horizon_s: float = 3.0  # standing, a sideways drift that would bring the body onto
     # the object within this long ends the run (it cannot move sideways in place)
     drift_s: float = 3.0  # the sideways drift beside the object is fitted over this long
+    unseen_horizon_s: float = 6.0  # the same with the card unseen: the last position moved on
+    # by the last rate is a guess (the card's offset from the body, a rate from few sightings)
     mode: str = "turn"  # or "reverse"
     turn_duty: int = 400
     turn_timeout_s: float = 8.0
@@ -226,7 +228,7 @@ class Controller:
         rate, x0 = np.polyfit(t, x, 1)
         return h[-1][0], float(x0), float(rate)
 
-    def _pushed(self, t: float) -> bool:
+    def _pushed(self, t: float, seen: bool = True) -> bool:
         """Standing beside the object (holding, or the marker missing since): a sideways drift
         that brings the body within block_margin_m of it within push_horizon_s (or has
         already, where the marker was last seen and the drift has taken it since)."""
@@ -234,11 +236,12 @@ class Controller:
         if fit is None:
             return False
         t0, lateral, rate = fit
-        return self.closing(lateral + rate * (t - t0), rate)
+        return self.closing(lateral + rate * (t - t0), rate, seen)
 
-    def closing(self, lateral: float, rate: float) -> bool:
+    def closing(self, lateral: float, rate: float, seen: bool = True) -> bool:
         """Whether a body at this lateral position, drifting sideways at this rate (m/s), is
-        within block_margin_m of the object's extent or comes so within push_horizon_s."""
+        within block_margin_m of the object's extent or comes so within push_horizon_s
+        (unseen_horizon_s when the card is unseen)."""
         cfg = self.cfg
         if self.keep_out is None:
             return False
@@ -248,7 +251,8 @@ class Controller:
         reach = cfg.half_width_m + cfg.block_margin_m
         gap = lateral - reach - x1 if lateral > x1 else x0 - reach - lateral
         toward = -rate if lateral > x1 else rate
-        return toward > 0 and gap < toward * cfg.push_horizon_s
+        horizon = cfg.push_horizon_s if seen else cfg.unseen_horizon_s
+        return toward > 0 and gap < toward * horizon
 
     def overlaps(self, lateral: float | None, margin: float = 0.0) -> bool:
         """Whether the robot's body at this lateral position comes within margin of the
@@ -266,7 +270,7 @@ class Controller:
             return self._turning(obs)
         if obs.depth_m is None:
             self.missing += 1
-            if self.phase in (HOLD, WAIT, LOST) and self._pushed(obs.t):
+            if self.phase in (HOLD, WAIT, LOST) and self._pushed(obs.t, seen=False):
                 self.fault = PUSHED
                 return self._stop(BLOCKED, None)
             if obs.invalid:

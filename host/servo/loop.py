@@ -481,7 +481,7 @@ class Servo:
         if not cmd.is_stop and cmd.phase in ("find", "search") and c.sweeps(s.z, s.x):
             return TURN_BLOCKED
         # unseen for a few frames (seen, the controller's hold watches the drift itself)
-        if t - s.t > 0.1 and c.closing(s.x + s.vx * (t - s.t), s.vx):
+        if t - s.t > 0.1 and c.closing(s.x + s.vx * (t - s.t), s.vx, seen=False):
             return DRIFTED
         return ""
 
