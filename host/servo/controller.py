@@ -47,6 +47,8 @@ WAIT, HOLD, DRIVE, CREEP, TURN, LOST, STALE, SEARCH, BLOCKED = (
     "wait", "hold", "drive", "creep", "turn", "lost", "stale", "search", "blocked")
 LINE_BLOCKED = "the robot's line passes through the object"
 PUSHED = "pushed sideways onto the object while holding"
+DRIFTED = "drifting sideways onto the object while the marker is unseen"
+TURN_BLOCKED = "turning here would sweep the robot's body into the object"
 
 
 @dataclass(frozen=True)
@@ -69,6 +71,14 @@ class ControlConfig:
     # and room for the lateral hold error and a sideways drift while holding
     block_m: float = 0.15  # within this depth of the object, the body must be clear of it
     block_margin_m: float = 0.02  # by this much (the object's edge is measured to a pixel or two)
+    turn_radius_m: float = 0.115  # a turn in place sweeps this circle: half the body's diagonal
+    path_margin_m: float = 0.10  # fixed objects this far beyond the target's depth are in its path
+    cell_m: float = 0.02  # the fixed objects' floor cells (perception.fixed_cells)
+    push_horizon_s: float = 3.0  # standing, a sideways drift that would bring the body onto
+    # the object within this long ends the run (it cannot move sideways in place)
+    drift_s: float = 3.0  # the sideways drift beside the object is fitted over this long
+    unseen_horizon_s: float = 6.0  # the same with the card unseen: the last position moved on
+    # by the last rate is a guess (the card's offset from the body, a rate from few sightings)
     mode: str = "turn"  # or "reverse"
     turn_duty: int = 400
     turn_timeout_s: float = 8.0
@@ -115,6 +125,11 @@ class Controller:
         self.floor = config.min_duty
         self.lateral_ref: float | None = None  # the lane the robot holds (m)
         self.keep_out: tuple[float, float] | None = None  # the object's lateral extent (m)
+        # the floor cells (depth, lateral; m) of the scene's fixed objects (perception.
+        # fixed_cells): the lane keeps clear of those between the robot and the target, and a
+        # turn in place of all of them
+        self.fixed: np.ndarray = np.zeros((0, 2))
+        self._beside: list[tuple[float, float]] = []  # (t, lateral) seen near the target depth
         self.trim = 0.0  # fraction of duty added to the right wheel, taken from the left
         self.fault = ""  # why the robot must stay stopped (the run ends), "" if none
         self._last_t: float | None = None
@@ -147,16 +162,97 @@ class Controller:
 
     # ------------------------------------------------------------------------- update
 
-    def lane(self) -> float | None:
-        """The lateral position to hold: the first seen, moved clear of the object."""
-        x = self.lateral_ref
-        if x is None or self.keep_out is None:
-            return x
+    def others(self) -> np.ndarray:
+        """The fixed objects' cells but for the target's own (its extent is the keep-out)."""
+        cells = self.fixed
+        if not len(cells) or self.keep_out is None:
+            return cells
         x0, x1 = self.keep_out
-        lo, hi = x0 - self.cfg.clearance_m, x1 + self.cfg.clearance_m
-        if lo < x < hi:
-            return lo if x - lo < hi - x else hi
+        c = self.cfg.cell_m
+        return cells[~((cells[:, 1] > x0 - c) & (cells[:, 1] < x1 + c))]
+
+    def ahead(self, depth_m: float) -> np.ndarray:
+        """The other fixed objects' cells in the robot's path from depth_m to the target (to
+        path_margin_m beyond it)."""
+        cells, cfg = self.others(), self.cfg
+        if depth_m > self.target_m:
+            lo, hi = self.target_m - cfg.path_margin_m, depth_m
+        else:
+            lo, hi = depth_m, self.target_m + cfg.path_margin_m
+        return cells[(cells[:, 0] >= lo) & (cells[:, 0] <= hi)]
+
+    def lane(self, depth_m: float | None = None) -> float | None:
+        """The lateral position to hold: the first seen, moved clear of the object (and, given
+        the robot's depth, of the fixed objects between it and the target) by clearance_m,
+        centre to side, to the nearer side."""
+        x = self.lateral_ref
+        if x is None:
+            return x
+        c = self.cfg.clearance_m
+        spans = [] if self.keep_out is None else [(self.keep_out[0] - c, self.keep_out[1] + c)]
+        if depth_m is not None:
+            r = c + self.cfg.cell_m / 2
+            spans += [(float(u) - r, float(u) + r) for u in self.ahead(depth_m)[:, 1]]
+        for lo, hi in merged(spans):
+            if lo < x < hi:
+                return lo if x - lo < hi - x else hi
         return x
+
+    def sweeps(self, depth_m: float, lateral_m: float | None) -> bool:
+        """Whether a turn in place here sweeps the body (a circle of turn_radius_m) within
+        block_margin_m of the object's extent or of a fixed object's cell in its path (the
+        background's cells, behind the robot, are not: far away their depth is noisy; nor
+        those inside its own body: the sighting is then of a look-alike standing there)."""
+        if lateral_m is None:
+            return False
+        cfg = self.cfg
+        reach = cfg.turn_radius_m + cfg.block_margin_m
+        if abs(depth_m - self.target_m) < reach and self.overlaps(
+                lateral_m, reach - cfg.half_width_m):
+            return True
+        cells = self.ahead(depth_m)
+        dz, dx = cells[:, 0] - depth_m, cells[:, 1] - lateral_m
+        own = (np.abs(dz) < 0.06) & (np.abs(dx) < cfg.half_width_m)  # a look-alike's body
+        return bool(((np.hypot(dz, dx) < reach + cfg.cell_m / 2) & ~own).any())
+
+    def drift(self) -> tuple[float, float, float] | None:
+        """(time, lateral, lateral rate) of the robot beside the object: a line through its
+        sightings near the target's depth over the last drift_s (at least four over 1 s: a
+        slow push shows over seconds, and a card seen now and then gives no rate over the
+        controller's 0.5 s fit), or None."""
+        h = self._beside
+        if len(h) < 4 or h[-1][0] - h[0][0] < 1.0:
+            return None
+        t = np.array([o[0] for o in h]) - h[-1][0]
+        x = np.array([o[1] for o in h])
+        rate, x0 = np.polyfit(t, x, 1)
+        return h[-1][0], float(x0), float(rate)
+
+    def _pushed(self, t: float, seen: bool = True) -> bool:
+        """Standing beside the object (holding, or the marker missing since): a sideways drift
+        that brings the body within block_margin_m of it within push_horizon_s (or has
+        already, where the marker was last seen and the drift has taken it since)."""
+        fit = self.drift()
+        if fit is None:
+            return False
+        t0, lateral, rate = fit
+        return self.closing(lateral + rate * (t - t0), rate, seen)
+
+    def closing(self, lateral: float, rate: float, seen: bool = True) -> bool:
+        """Whether a body at this lateral position, drifting sideways at this rate (m/s), is
+        within block_margin_m of the object's extent or comes so within push_horizon_s
+        (unseen_horizon_s when the card is unseen)."""
+        cfg = self.cfg
+        if self.keep_out is None:
+            return False
+        if self.overlaps(lateral, cfg.block_margin_m):
+            return True
+        x0, x1 = self.keep_out
+        reach = cfg.half_width_m + cfg.block_margin_m
+        gap = lateral - reach - x1 if lateral > x1 else x0 - reach - lateral
+        toward = -rate if lateral > x1 else rate
+        horizon = cfg.push_horizon_s if seen else cfg.unseen_horizon_s
+        return toward > 0 and gap < toward * horizon
 
     def overlaps(self, lateral: float | None, margin: float = 0.0) -> bool:
         """Whether the robot's body at this lateral position comes within margin of the
@@ -174,6 +270,9 @@ class Controller:
             return self._turning(obs)
         if obs.depth_m is None:
             self.missing += 1
+            if self.phase in (HOLD, WAIT, LOST) and self._pushed(obs.t, seen=False):
+                self.fault = PUSHED
+                return self._stop(BLOCKED, None)
             if obs.invalid:
                 return self._stop(STALE, None)
             if not self.seen:
@@ -205,6 +304,14 @@ class Controller:
         if abs(e) < cfg.block_m and self.overlaps(obs.lateral_m, cfg.block_margin_m):
             self.fault = PUSHED if self.phase == HOLD else LINE_BLOCKED
             return self._stop(BLOCKED, e)
+        if abs(e) < cfg.block_m and obs.lateral_m is not None:
+            self._beside.append((obs.t, obs.lateral_m))
+            self._beside = [o for o in self._beside if obs.t - o[0] <= cfg.drift_s]
+        else:
+            self._beside.clear()
+        if self.phase == HOLD and self._pushed(obs.t):
+            self.fault = PUSHED
+            return self._stop(BLOCKED, e)
         if self.phase == HOLD and abs(e) <= cfg.tolerance_m:
             return self._stop(HOLD, e)
         moving_in = self.phase in (DRIVE, CREEP)
@@ -215,6 +322,9 @@ class Controller:
             return self._stop(HOLD, e)
         forward = away == self.facing_away
         if not forward and cfg.mode == "turn":
+            if self.sweeps(z, obs.lateral_m):
+                self.fault = TURN_BLOCKED
+                return self._stop(BLOCKED, e)
             return self._start_turn(obs, e)
         creeping = abs(e) <= cfg.creep_m
         if creeping and self.phase == CREEP and abs(zdot) < 0.004:
@@ -223,7 +333,7 @@ class Controller:
         duty = self.floor if creeping else min(cfg.max_duty, int(self.floor + gain * abs(e)))
         duty = duty if forward else -duty
         steer = 0.0
-        lane = self.lane()
+        lane = self.lane(z)
         if obs.lateral_m is not None and lane is not None:
             # x' = v sin(theta): to cancel a drift to the right, turn so that v cos(theta) * dtheta
             # is negative; v cos(theta) is positive exactly when moving away from the camera
@@ -299,3 +409,14 @@ class Controller:
         self.history.clear()
         self.missing = 0
         return self._stop(WAIT, None)
+
+
+def merged(spans: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    """Overlapping intervals joined (sorted by their start)."""
+    out: list[tuple[float, float]] = []
+    for lo, hi in sorted(spans):
+        if out and lo <= out[-1][1]:
+            out[-1] = (out[-1][0], max(out[-1][1], hi))
+        else:
+            out.append((lo, hi))
+    return out

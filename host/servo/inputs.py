@@ -84,7 +84,7 @@ def floor_shift_px(disp: np.ndarray, floor: Floor, min_rows: int = 10,
         row = disp[y][valid]
         if row.size < w // 4:
             continue
-        line = float(floor.disparity(np.float64(y)))
+        line = float(floor.disparity(np.array([y], np.float64))[0])
         if reference is not None:
             ref = reference[y][valid]
             ref = ref[np.isfinite(ref)]

@@ -25,6 +25,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import cv2
 import numpy as np
@@ -32,9 +33,16 @@ import numpy as np
 from host.camera.geometry import Geometry
 from host.camera.source import CameraError, StereoFrame, StereoSource
 from host.errors import HostError
-from host.link.client import RobotReset
+from host.link.client import RobotLink, RobotReset
 from host.servo.acquire import NOT_MOVED, AcquireConfig, Acquisition
-from host.servo.controller import Command, ControlConfig, Controller, Observation
+from host.servo.controller import (
+    DRIFTED,
+    TURN_BLOCKED,
+    Command,
+    ControlConfig,
+    Controller,
+    Observation,
+)
 from host.servo.deflicker import deflickered
 from host.servo.estimator import AGAINST, OUTSIDE, STILL, Estimator, EstimatorConfig, Sighting
 from host.servo.inputs import FrozenSensors, camera_moved, views_agree
@@ -44,6 +52,9 @@ from host.servo.perception import (
     StripMap,
     Target,
     fit_floor,
+    fixed_cells,
+    fixed_in_path,
+    in_view,
     lane_obstacle,
     lane_window,
     match_exposure,
@@ -96,6 +107,8 @@ class ServoConfig:
     moved_rows: float = 0.005  # of the focal length (0.3 degrees of pitch): the camera moved
     acquire_tries: int = 3  # look-alikes that do not move, left out one after the other
     lane_width_px: int = 320  # the lane is watched on frames scaled down to about this width
+    ring_ratio: float = 1.7  # the marker's light ring, in disc radii (as printed: marker.py)
+    react_s: float = 0.33  # a command's reaction and the wheels' run-down (the view's check)
     timing: TimingConfig = field(default_factory=TimingConfig)
     estimator: EstimatorConfig = field(default_factory=EstimatorConfig)
     acquire: AcquireConfig = field(default_factory=AcquireConfig)
@@ -146,9 +159,10 @@ class _Seen:
 
 
 class Servo:
-    def __init__(self, source: StereoSource, link, params: MatcherParams, geometry: Geometry,
-                 control: ControlConfig = ControlConfig(), config: ServoConfig | None = None,
-                 clock: Callable[[], float] = time.monotonic, **overrides) -> None:
+    def __init__(self, source: StereoSource, link: RobotLink, params: MatcherParams,
+                 geometry: Geometry, control: ControlConfig = ControlConfig(),
+                 config: ServoConfig | None = None,
+                 clock: Callable[[], float] = time.monotonic, **overrides: Any) -> None:
         """overrides: fields of ServoConfig (marker=, marker_radius_m=, full_map= ...)."""
         self.cfg = dataclasses.replace(config or ServoConfig(), **overrides)
         self.source, self.link, self.params = source, link, params
@@ -220,8 +234,9 @@ class Servo:
         "stop", and the caller's loop ends there."""
         self.requested_stop = self.stop_reason = reason
 
-    def _notify(self, frame: StereoFrame, phase: str, reason: str, disp, y0: int,
-                pair: MarkerPair | None, row, rtt_ms: float = math.nan) -> None:
+    def _notify(self, frame: StereoFrame, phase: str, reason: str, disp: np.ndarray | None,
+                y0: int, pair: MarkerPair | None, row: LogRow | None,
+                rtt_ms: float = math.nan) -> None:
         if self.observers:
             snap = Snapshot(self.clock(), phase, reason, frame.left, disp, y0, self.target, pair,
                             row, link_stats(self.link, rtt_ms), self.geometry)
@@ -254,6 +269,8 @@ class Servo:
         self.controller = Controller(self.geometry.depth_m(target.disparity), self.control)
         self.controller.keep_out = self._extent(
             object_extent(without_floor(self.reference_map, self.floor), target))
+        self.controller.fixed = fixed_cells(self.reference_map, self.geometry,
+                                            self.control.cell_m)
         return target
 
     def _lane_map(self, reference: np.ndarray) -> np.ndarray:
@@ -355,7 +372,8 @@ class Servo:
 
     # ---------------------------------------------------------------------- the target
 
-    def _robot_region(self, pair: MarkerPair, shape: tuple[int, ...]) -> tuple[int, ...]:
+    def _robot_region(self, pair: MarkerPair, shape: tuple[int, ...]
+                      ) -> tuple[int, int, int, int]:
         """Image box (x0, y0, x1, y1) the robot may cover, from its marker."""
         ppm = pair.disparity / self.geometry.baseline_m
         h, w = shape[:2]
@@ -449,6 +467,55 @@ class Servo:
         if found is None:
             return ""
         return f"an object in the lane {found.ahead_m:.2f} m ahead"
+
+    def _spin_fault(self, t: float, cmd: Command) -> str:
+        """Standing or spinning to find the card (the acquisition's, the search after a turn,
+        a wait for the marker) where the robot was last known to be beside the object: a spin
+        that sweeps its body into the object (controller.sweeps; the turn's own check is the
+        controller's), or, the card unseen, the sideways drift it last had (a push, a slope)
+        bringing it onto the object (controller.closing): why the run ends, or ""."""
+        est, c = self.estimator, self.controller
+        if est.state is None or c is None or abs(est.state.z - c.target_m) >= c.cfg.block_m:
+            return ""
+        s = est.state
+        if not cmd.is_stop and cmd.phase in ("find", "search") and c.sweeps(s.z, s.x):
+            return TURN_BLOCKED
+        # unseen for a few frames (seen, the controller's hold watches the drift itself)
+        if t - s.t > 0.1 and c.closing(s.x + s.vx * (t - s.t), s.vx, seen=False):
+            return DRIFTED
+        return ""
+
+    def _path_fault(self, frame: StereoFrame, cmd: Command) -> str:
+        """Why the command must not be sent and the run ends, or "": the marker's ring would
+        leave the picture before a stop acts (the robot at the picture's edge, or near the
+        camera; a probe may go either way), or, driving toward the target, a fixed object of
+        the reference stands where the body goes within its stopping distance (the lane
+        steers clear of them, this is the backstop)."""
+        est, c = self.estimator, self.controller
+        if est.state is None or c is None:
+            return ""
+        z, x = est.state.z, est.state.x
+        toward = cmd.phase == "probe" or c.target_m < z
+        pair = self.last_pair
+        if pair is not None:
+            h, w = frame.left.shape[:2]
+            run = abs(est.state.vz) * self.cfg.react_s + 0.02
+            scale = z / max(z - run, 0.2) if toward else 1.0
+            g = self.geometry
+            if not in_view(pair.left.u, pair.left.v, pair.left.radius * self.cfg.ring_ratio,
+                           (w, h), scale, g.cx, g.cy):
+                return "the marker would leave the view: the robot is at the picture's edge"
+        duty = abs(cmd.left + cmd.right) / 2
+        speed = max(abs(est.state.vz), est.cfg.max_speed_mps * duty / 1000)
+        reach = stopping_distance_m(speed) + self.cfg.lane_margin_m
+        if cmd.phase == "probe":  # a sighting not yet trusted (maybe a look-alike standing
+            return ""  # in the reference, its own body a fixed object); the probe is short
+        cfg = c.cfg
+        ahead = fixed_in_path(c.others(), z, x, -1 if c.target_m < z else 1, reach,
+                              cfg.half_width_m + cfg.block_margin_m / 2, cfg.cell_m)
+        if ahead is not None:
+            return f"a fixed object stands in the robot's path {ahead:.2f} m ahead"
+        return ""
 
     # -------------------------------------------------------------------- acquisition
 
@@ -596,7 +663,7 @@ class Servo:
             cmd = self._acquire(t, position, d)
             return Command(0, 0, "stop", None) if self.stop_reason else cmd
         self._check_motion(t, position is not None)
-        if self.stop_reason:
+        if self._must_stop():  # the motion check may have ended the run
             return Command(0, 0, "stop", None)
         depth, lateral = position if position is not None else (None, None)
         aspect = pair.left.aspect if pair is not None else 1.0
@@ -604,6 +671,9 @@ class Servo:
         if self.controller.fault:  # it cannot go on: the run ends here
             self.stop_reason = self.controller.fault
         return cmd
+
+    def _must_stop(self) -> bool:
+        return bool(self.stop_reason)
 
     def _send(self, cmd: Command, t: float = math.nan) -> None:
         """The command over the link. A reset the link learns of (it has said HELLO again,
@@ -658,6 +728,7 @@ class Servo:
         c = Controller(old.target_m, self.control)
         c.cfg, c.keep_out, c.trim, c.facing_away = old.cfg, old.keep_out, old.trim, \
             old.facing_away
+        c.fixed = old.fixed
         self.controller = c
         self._cmd = Command(0, 0, "wait", None)
         self.notes.append(f"recovered ({why}): re-acquiring the robot")
@@ -713,6 +784,7 @@ class Servo:
         self.controller.target_m = self.geometry.depth_m(target.disparity)
         self.controller.keep_out = self._extent(
             object_extent(without_floor(reference, floor), target))
+        self.controller.fixed = fixed_cells(reference, self.geometry, self.control.cell_m)
         assert self._strips is not None
         self._strips.reset()
         self._remeasure_t = None
@@ -753,6 +825,11 @@ class Servo:
         while; the controller learns that it stood (its creep floor must not rise)."""
         assert self.controller is not None
         moving = not cmd.is_stop and cmd.phase in ("drive", "creep", "probe")
+        fault = self._path_fault(frame, cmd) if moving else self._spin_fault(frame.t_left, cmd)
+        if fault:  # nothing to wait for: the run ends here
+            self.stop_reason = self.stop_reason or fault
+            self.controller.phase = "stop"
+            return Command(0, 0, "stop", cmd.error_m), invalid
         blocked = self._lane_blocked(frame, cmd) if moving else ""
         rec = self.recovery
         if blocked:

@@ -110,7 +110,7 @@ def nearest_object(disp: np.ndarray, min_area: int, step: float = 0.5,
     while level > step:
         levels.append(level)
         level -= step
-    seen: dict[int, tuple] = {}
+    seen: dict[int, tuple[int, np.ndarray, np.ndarray]] = {}
 
     def reaches(k: int) -> bool:
         if k not in seen:
@@ -152,7 +152,7 @@ def median_map(disps: list[np.ndarray]) -> np.ndarray:
     stack = np.stack(disps)
     with np.errstate(all="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # pixels invalid in every map stay NaN
-        return np.nanmedian(stack, axis=0) if len(disps) > 1 else stack[0]
+        return np.asarray(np.nanmedian(stack, axis=0)) if len(disps) > 1 else stack[0]
 
 
 def reference_target(disps: list[np.ndarray], min_area: int) -> tuple[Target, Floor | None]:
@@ -264,7 +264,7 @@ def object_extent(disp: np.ndarray, target: Target, tol_px: float | None = None,
         near = np.abs(disp - d) <= tol
     cols = near[y:y + bh].mean(axis=0) >= share
     x0, x1 = _run_through(cols, x, x + bw - 1, gap_px)
-    if x0 is None:
+    if x0 is None or x1 is None:
         return target
     valid_cols = np.flatnonzero(np.isfinite(disp[y:y + bh]).any(axis=0))
     if valid_cols.size and x0 <= valid_cols[0] + 1:
@@ -272,9 +272,8 @@ def object_extent(disp: np.ndarray, target: Target, tol_px: float | None = None,
     if valid_cols.size and x1 >= valid_cols[-1] - 1:
         x1 = w - 1
     rows = near[:, x0:x1 + 1].mean(axis=1) >= share
-    y0, y1 = _run_through(rows, y, y + bh - 1, gap_px)
-    if y0 is None:
-        y0, y1 = y, y + bh - 1
+    y0_, y1_ = _run_through(rows, y, y + bh - 1, gap_px)
+    y0, y1 = (y, y + bh - 1) if y0_ is None or y1_ is None else (y0_, y1_)
     area = int(near[y0:y1 + 1, x0:x1 + 1].sum())
     return Target(d, area, (int(x0), int(y0), int(x1 - x0 + 1), int(y1 - y0 + 1)),
                   target.spread)
@@ -440,3 +439,73 @@ def lane_obstacle(disp: np.ndarray, geometry: Geometry, depth_m: float, lateral_
     if area < max(25.0, (min_size_m * g.focal_px / zm) ** 2):
         return None
     return LaneObstacle(zm, (zm - depth_m) * direction, area)
+
+
+def fixed_cells(disp: np.ndarray, geometry: Geometry, cell_m: float = 0.02,
+                min_height_m: float = 0.05, floor_clear_m: float = 0.03, height_m: float = 0.30,
+                camera_height_m: float = 0.25) -> np.ndarray:
+    """Where the scene's fixed objects stand, seen from above: the (depth, lateral) centres (m)
+    of the cell_m x cell_m floor cells that hold an upright face, as an (n, 2) array. A cell's
+    points are those of the map between floor_clear_m and height_m above the floor (the
+    robot's height; the floor is never an object); it holds a face when they rise at least
+    min_height_m, span two image columns or more, and number at least half of what a face
+    cell_m wide and min_height_m tall at that depth shows. disp: the reference map (the scene
+    without the robot, px, NaN invalid). A box's front face fills each cell it stands on with
+    hundreds of points; a mismatch (the near floor beyond the search range, the first valid
+    column) puts a few dozen in a small patch or a single column. The target is among them
+    (the controller leaves its extent to the keep-out)."""
+    g = geometry
+    with np.errstate(invalid="ignore"):
+        vs, us = np.nonzero(np.isfinite(disp) & (disp > 0.5))
+    d = disp[vs, us].astype(np.float64)
+    y = camera_height_m - g.baseline_m * (vs - g.cy) / d
+    keep = (y > floor_clear_m) & (y < height_m)
+    d, y, u = d[keep], y[keep], us[keep]
+    if d.size == 0:
+        return np.zeros((0, 2))
+    z = g.focal_px * g.baseline_m / d
+    x = g.baseline_m * (u - g.cx) / d
+    cells = np.stack([np.floor(z / cell_m), np.floor(x / cell_m)], axis=1).astype(np.int64)
+    found, which, counts = np.unique(cells, axis=0, return_inverse=True, return_counts=True)
+    which = which.ravel()
+    n = len(found)
+    y_lo, y_hi = np.full(n, np.inf), np.full(n, -np.inf)
+    u_lo, u_hi = np.full(n, np.inf), np.full(n, -np.inf)
+    np.minimum.at(y_lo, which, y)
+    np.maximum.at(y_hi, which, y)
+    np.minimum.at(u_lo, which, u)
+    np.maximum.at(u_hi, which, u)
+    zc = (found[:, 0] + 0.5) * cell_m
+    face = 0.5 * (g.focal_px * cell_m / zc) * (g.focal_px * min_height_m / zc)
+    ok = (y_hi - y_lo >= min_height_m) & (u_hi - u_lo >= 1) & (counts >= face)
+    return np.asarray((found[ok] + 0.5) * cell_m, np.float64)
+
+
+def fixed_in_path(cells: np.ndarray, depth_m: float, lateral_m: float, direction: int,
+                  reach_m: float, half_width_m: float, cell_m: float = 0.02,
+                  body_m: float = 0.10, own_m: float = 0.06) -> float | None:
+    """How far ahead (m, from the robot's centre) the nearest of a fixed object's floor cells
+    (fixed_cells) stands in the stretch the robot's body (half_width_m each side of its line
+    at lateral_m) sweeps within body_m + reach_m ahead (direction +1: away from the camera,
+    -1: toward it); None when the stretch is clear. A cell within own_m of the robot's
+    centre is where the robot itself stands: a fixed object there means the sighting is of
+    it (another robot's card, standing in the reference), which the acquisition's probe
+    finds out, not an obstacle."""
+    if not len(cells):
+        return None
+    ahead = (cells[:, 0] - depth_m) * direction
+    hit = (ahead >= own_m) & (ahead <= body_m + reach_m) & (
+        np.abs(cells[:, 1] - lateral_m) < half_width_m + cell_m / 2)
+    return float(ahead[hit].min()) if hit.any() else None
+
+
+def in_view(u: float, v: float, ring_px: float, size: tuple[int, int], scale: float = 1.0,
+            cx: float | None = None, cy: float | None = None, margin_px: float = 2.0) -> bool:
+    """Whether the marker's whole ring (centre u, v and radius ring_px in the left image) stays
+    inside the picture, by margin_px, once the robot's depth has shrunk by the factor 1/scale
+    (scale > 1: nearer the camera; image offsets from the centre cx, cy and sizes grow by it)."""
+    w, h = size
+    cx = (w - 1) / 2 if cx is None else cx
+    cy = (h - 1) / 2 if cy is None else cy
+    u2, v2, r2 = cx + (u - cx) * scale, cy + (v - cy) * scale, ring_px * scale + margin_px
+    return r2 <= u2 <= w - 1 - r2 and r2 <= v2 <= h - 1 - r2

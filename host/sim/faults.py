@@ -133,7 +133,10 @@ def random_hazards(rng: np.random.Generator, target_z: float, target_index: int 
     """The named events of issue 23, each drawn with probability `rate` (the robot hidden
     behind the object, which no servo can hold through, with rate / 5), each of random size."""
     events: list[Event] = []
-    sign = lambda: float(rng.choice([-1.0, 1.0]))  # noqa: E731
+
+    def sign() -> float:
+        return float(rng.choice([-1.0, 1.0]))
+
     if rng.random() < rate:  # placed facing the camera, or side-on
         angle = float(rng.choice([180.0, 60.0, 90.0])) * sign() + float(rng.uniform(-5, 5))
         events.append(Event(0.0, "facing", angle_deg=angle))
@@ -190,8 +193,7 @@ def random_faults(rng: np.random.Generator, target_z: float, target_index: int =
                         latency_ms=float(rng.uniform(60, 120)),
                         push_mps=float(rng.uniform(-0.01, 0.01)))
     camera = CameraFaults(gain=_pair(rng, 0.8, 1.2), bias=_pair(rng, -15, 15),
-                          white=tuple(tuple(float(g) for g in rng.uniform(0.85, 1.15, 3))
-                                      for _ in range(2)),
+                          white=tuple(_white(rng) for _ in range(2)),
                           skew_ms=float(rng.uniform(0, 33)), exposure_ms=float(rng.uniform(5, 30)),
                           drop=float(rng.uniform(0, 0.05)), noise=float(rng.uniform(1.5, 3.5)),
                           )
@@ -219,3 +221,9 @@ def random_faults(rng: np.random.Generator, target_z: float, target_index: int =
                                                   if rng.random() < silent else None),
                                  seed=int(rng.integers(1 << 30)))
     return WorldFaults(motor, camera, tuple(events), link_faults)
+
+
+def _white(rng: np.random.Generator) -> tuple[float, float, float]:
+    """One sensor's white balance: a BGR gain each, 0.85-1.15."""
+    b, g, r = (float(x) for x in rng.uniform(0.85, 1.15, 3))
+    return b, g, r

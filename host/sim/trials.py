@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from host.camera.source import CameraError
+from host.emulator.emulator import Faults as LinkFaults
 from host.link import protocol_gen as gen
 from host.link.client import LinkError
 from host.servo.controller import ControlConfig
@@ -92,7 +93,7 @@ def trial_setup(seed: int, index: int, size: tuple[int, int], params: MatcherPar
                  calib_seed=calib_seed)
 
 
-def _reset(rng: np.random.Generator, link):
+def _reset(rng: np.random.Generator, link: LinkFaults) -> LinkFaults:
     """Now and then a reset of the board between 2 and 8 s (watchdog or brown-out), its BOOT
     frame lost in half of them."""
     u = float(rng.random())
