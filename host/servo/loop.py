@@ -46,7 +46,7 @@ from host.servo.controller import (
 from host.servo.deflicker import deflickered
 from host.servo.estimator import AGAINST, OUTSIDE, STILL, Estimator, EstimatorConfig, Sighting
 from host.servo.inputs import FrozenSensors, camera_moved, views_agree
-from host.servo.marker import MarkerPair, block_disparity, marker_candidates
+from host.servo.marker import RING_RATIO, MarkerPair, block_disparity, marker_candidates
 from host.servo.perception import (
     Floor,
     StripMap,
@@ -107,7 +107,7 @@ class ServoConfig:
     moved_rows: float = 0.005  # of the focal length (0.3 degrees of pitch): the camera moved
     acquire_tries: int = 3  # look-alikes that do not move, left out one after the other
     lane_width_px: int = 320  # the lane is watched on frames scaled down to about this width
-    ring_ratio: float = 1.7  # the marker's light ring, in disc radii (as printed: marker.py)
+    ring_ratio: float = RING_RATIO  # the marker's light ring, in disc radii (as printed)
     react_s: float = 0.33  # a command's reaction and the wheels' run-down (the view's check)
     timing: TimingConfig = field(default_factory=TimingConfig)
     estimator: EstimatorConfig = field(default_factory=EstimatorConfig)

@@ -1,4 +1,4 @@
-"""The robot's marker: a dark disc inside a light ring (ring radius 1.7 x disc radius), printed
+"""The robot's marker: a dark disc inside a light ring (its radius RING_RATIO discs), printed
 on both sides of a card on a mast, so that it shows whether the robot faces the camera or not.
 ArUco (DICT_4X4_50, cv2.aruco.ArucoDetector) is the alternative.
 
@@ -17,6 +17,8 @@ import numpy as np
 from host.stereo.grey import to_grey
 
 Window = tuple[int, int, int, int]  # x0, y0, x1, y1: a search window, columns x0:x1, rows y0:y1
+
+RING_RATIO = 1.7  # the printed card: the light ring's outer radius in disc radii
 
 
 @dataclass(frozen=True)

@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from host.camera.geometry import Geometry
+from host.servo.marker import RING_RATIO
 from host.sim.faults import MotorFaults
 
 
@@ -53,7 +54,7 @@ class Robot:
     v_right: float = 0.0
     marker_height_m: float = 0.20
     marker_radius_m: float = 0.03  # the dark disc; the light ring reaches ring_ratio times it
-    ring_ratio: float = 1.7
+    ring_ratio: float = RING_RATIO
     body_width_m: float = 0.16
     body_height_m: float = 0.12
     marker_hidden: bool = False  # something between the camera and the card (tests)
