@@ -12,7 +12,7 @@ import pytest
 
 from host.cli import main
 from host.commands.servo_outcome import NOT_REACHED, outcome
-from host.servo.loop import LogRow, Servo
+from host.servo.loop import LogRow, run_outcome
 
 
 def _row(t: float, phase: str, robot_px: float = math.nan, reason: str = "") -> LogRow:
@@ -22,13 +22,13 @@ def _row(t: float, phase: str, robot_px: float = math.nan, reason: str = "") -> 
 
 
 class _Run:
-    """What outcome() reads of a finished Servo."""
+    """What outcome() reads of a finished Servo: its log rows, the stop asked for, the target."""
 
     def __init__(self, rows: list[LogRow], requested_stop: str | None = None) -> None:
         self.rows, self.requested_stop, self.target_m = rows, requested_stop, 1.25
 
     def outcome(self) -> tuple[str, str]:
-        return Servo.outcome(self)  # type: ignore[arg-type]
+        return run_outcome(self.rows)
 
 
 @pytest.mark.parametrize("rows, stop, status, words", [

@@ -865,13 +865,18 @@ class Servo:
         return False
 
     def outcome(self) -> tuple[str, str]:
-        """("held", "") when the last step held at the target with the marker in view, else
-        ("stopped", the reason)."""
-        if not self.rows:
-            return "stopped", "no frame"
-        last = self.rows[-1]
-        if last.phase == "hold" and math.isfinite(last.depth_m):
-            return "held", ""
-        if not any(math.isfinite(r.robot_px) for r in self.rows):
-            return "stopped", "the marker was never seen"
-        return "stopped", last.reason or f"ended in phase {last.phase}"
+        """How the run ended, from its log (run_outcome)."""
+        return run_outcome(self.rows)
+
+
+def run_outcome(rows: list[LogRow]) -> tuple[str, str]:
+    """("held", "") when a run's last step held at the target with the marker in view, else
+    ("stopped", the reason)."""
+    if not rows:
+        return "stopped", "no frame"
+    last = rows[-1]
+    if last.phase == "hold" and math.isfinite(last.depth_m):
+        return "held", ""
+    if not any(math.isfinite(r.robot_px) for r in rows):
+        return "stopped", "the marker was never seen"
+    return "stopped", last.reason or f"ended in phase {last.phase}"
