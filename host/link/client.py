@@ -168,6 +168,15 @@ class RobotLink:
                     return msg
         return None
 
+    def write_raw(self, data: bytes) -> None:
+        """Send bytes as given, framed or not (conformance checks and tools: a frame the client
+        would never build, a reply out of place)."""
+        self._write(data)
+
+    def wait_for(self, match: Callable[[Any], bool], timeout_s: float) -> Any:
+        """The first message from the robot that `match` accepts within timeout_s, else None."""
+        return self._await(match, timeout_s)
+
     def _resync(self, why: str) -> RobotReset:
         """After a reset: HELLO again and the configuration re-applied, so nothing is driven on
         a board that forgot it; the RobotReset to raise (a LinkError if the robot is gone)."""

@@ -197,9 +197,9 @@ def test_a_watchdog_reset_is_reported_and_the_motors_stop_before_it(flashed_hang
         with RobotLink(uno.path, handshake_s=10) as robot:
             robot.drive(500, 500)
             assert uno.wait(lambda u: u.motors() == (500, 500), 2)
-            robot._write(encode_frame(99, *pack(gen.SetDrive(left=999, right=-999))))
+            robot.write_raw(encode_frame(99, *pack(gen.SetDrive(left=999, right=-999))))
             with pytest.raises(LinkError) as e:
-                robot._await(lambda m: False, 1.0)
+                robot.wait_for(lambda m: False, 1.0)
             assert str(e.value) == ("the robot reset during the session: watchdog: the firmware "
                                     "hung; the watchdog stopped the motors and reset the board")
         assert uno.motors() == (0, 0)

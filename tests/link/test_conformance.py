@@ -61,8 +61,8 @@ def test_a_resent_command_is_not_applied_twice(robot_port: str) -> None:
         frame = encode_frame(77, *pack(gen.SetDrive(left=200, right=200)))
         replies = []
         for _ in range(2):
-            robot._write(frame)
-            replies.append(robot._await(lambda m: isinstance(m, gen.Ack) and m.seq == 77, 0.5))
+            robot.write_raw(frame)
+            replies.append(robot.wait_for(lambda m: isinstance(m, gen.Ack) and m.seq == 77, 0.5))
         assert [r.result for r in replies] == [gen.AckResult.APPLIED, gen.AckResult.DUPLICATE]
 
 
@@ -89,11 +89,11 @@ def test_a_new_command_with_an_old_seq_is_applied_not_taken_for_a_resend(
         robot.set_config(link_timeout_ms=5000, accel_limit=0)
         replies = []
         for left in (300, -300):
-            robot._write(encode_frame(10, *pack(gen.SetDrive(left=left, right=left))))
+            robot.write_raw(encode_frame(10, *pack(gen.SetDrive(left=left, right=left))))
             # the answers to 255 polls take over half a second of line time: wait long enough
-            replies.append(robot._await(lambda m: isinstance(m, gen.Ack) and m.seq == 10, 3.0))
+            replies.append(robot.wait_for(lambda m: isinstance(m, gen.Ack) and m.seq == 10, 3.0))
             for seq in range(11, 11 + 255 if left > 0 else 11):
-                robot._write(encode_frame(seq & 0xFF, *pack(gen.GetStatus())))
+                robot.write_raw(encode_frame(seq & 0xFF, *pack(gen.GetStatus())))
         assert [r.result for r in replies] == [gen.AckResult.APPLIED, gen.AckResult.APPLIED]
         time.sleep(0.05)  # past the coast interval of the reversal
         assert robot.status().left == -300
@@ -101,12 +101,12 @@ def test_a_new_command_with_an_old_seq_is_applied_not_taken_for_a_resend(
 
 def test_out_of_range_and_wrong_direction_are_refused(robot_port: str) -> None:
     with RobotLink(robot_port) as robot:
-        robot._write(encode_frame(9, gen.SetDrive.ID, (1500).to_bytes(2, "little", signed=True)
+        robot.write_raw(encode_frame(9, gen.SetDrive.ID, (1500).to_bytes(2, "little", signed=True)
                                   + bytes(2)))
-        nack = robot._await(lambda m: isinstance(m, gen.Nack) and m.seq == 9, 0.5)
+        nack = robot.wait_for(lambda m: isinstance(m, gen.Nack) and m.seq == 9, 0.5)
         assert nack.error == gen.Error.OUT_OF_RANGE
-        robot._write(encode_frame(10, *pack(gen.Ack(seq=1, result=0))))
-        nack = robot._await(lambda m: isinstance(m, gen.Nack) and m.seq == 10, 0.5)
+        robot.write_raw(encode_frame(10, *pack(gen.Ack(seq=1, result=0))))
+        nack = robot.wait_for(lambda m: isinstance(m, gen.Nack) and m.seq == 10, 0.5)
         assert nack.error == gen.Error.WRONG_DIRECTION
 
 
