@@ -88,6 +88,32 @@ def marker_band(params: MatcherParams, d: float) -> MatcherParams:
     return params.replace(min_disparity=max(0, int(d) - 8), num_disparities=16)
 
 
+def marker_disparity(left: np.ndarray, right: np.ndarray, params: MatcherParams,
+                     pair: MarkerPair, whole: bool = False
+                     ) -> tuple[float, np.ndarray, tuple[int, int]]:
+    """Block-matching disparity over the marker, in its band of disparities (marker_band):
+    matched on only the window the ring's matches need (or, whole, on the whole map). Returns
+    the disparity (px, NaN: none), the map of the rows matched (full width, NaN outside the
+    window) and those rows (y0, y1)."""
+    band_params = marker_band(params, pair.disparity)
+    if whole:
+        disp = compute_disparity(left, right, band_params)
+        return block_disparity(disp, pair.left), disp, (0, left.shape[0])
+    # only the window the ring's matches need: its rows, its columns and, to their left,
+    # the search range in the right view
+    r = pair.left.radius
+    pad = 1.6 * r + params.block_size
+    h, w = left.shape[:2]
+    y0, y1 = max(0, int(pair.left.v - pad)), min(h, int(pair.left.v + pad) + 1)
+    reach = band_params.min_disparity + band_params.num_disparities
+    x0, x1 = max(0, int(pair.left.u - pad) - reach), min(w, int(pair.left.u + pad) + 1)
+    band = compute_disparity(left[y0:y1, x0:x1], right[y0:y1, x0:x1], band_params)
+    shifted = type(pair.left)(pair.left.u - x0, pair.left.v - y0, r, pair.left.aspect)
+    full = np.full((y1 - y0, w), np.nan, np.float32)
+    full[:, x0:x1] = band
+    return block_disparity(band, shifted), full, (y0, y1)
+
+
 @dataclass(frozen=True)
 class ServoConfig:
     marker: str = "disc"  # or "aruco"
@@ -200,6 +226,11 @@ class Servo:
         self._targets_before: list[Target] = []  # the targets a nearer object replaced
 
     @property
+    def strips(self) -> StripMap | None:
+        """The re-measure's map, matched a band per frame (None before the reference)."""
+        return self._strips
+
+    @property
     def stale_s(self) -> float:
         return self.cfg.timing.stale_s
 
@@ -291,27 +322,6 @@ class Servo:
 
     # --------------------------------------------------------------------- perception
 
-    def _robot_disparity(self, frame: StereoFrame, pair: MarkerPair
-                         ) -> tuple[float, np.ndarray, tuple[int, int]]:
-        """Block-matching disparity over the marker (a band of rows, or the whole map)."""
-        params = marker_band(self.params, pair.disparity)
-        if self.cfg.full_map:
-            disp = compute_disparity(frame.left, frame.right, params)
-            return block_disparity(disp, pair.left), disp, (0, frame.left.shape[0])
-        # only the window the ring's matches need: its rows, its columns and, to their left,
-        # the search range in the right view
-        r = pair.left.radius
-        pad = 1.6 * r + self.params.block_size
-        h, w = frame.left.shape[:2]
-        y0, y1 = max(0, int(pair.left.v - pad)), min(h, int(pair.left.v + pad) + 1)
-        reach = params.min_disparity + params.num_disparities
-        x0, x1 = max(0, int(pair.left.u - pad) - reach), min(w, int(pair.left.u + pad) + 1)
-        band = compute_disparity(frame.left[y0:y1, x0:x1], frame.right[y0:y1, x0:x1], params)
-        shifted = type(pair.left)(pair.left.u - x0, pair.left.v - y0, r, pair.left.aspect)
-        full = np.full((y1 - y0, w), np.nan, np.float32)
-        full[:, x0:x1] = band
-        return block_disparity(band, shifted), full, (y0, y1)
-
     @staticmethod
     def _sighting(t: float, pair: MarkerPair) -> Sighting:
         b = pair.left
@@ -360,7 +370,8 @@ class Servo:
                 if checked == 2:
                     break  # at most two cross-checks a frame
                 checked += 1
-                block, disp, rows = self._robot_disparity(frame, pair)
+                block, disp, rows = marker_disparity(frame.left, frame.right, self.params,
+                                                     pair, whole=cfg.full_map)
                 seen.block, seen.disp, seen.rows = block, disp, rows
                 if math.isfinite(block) and abs(block - pair.disparity) > cfg.max_mismatch_px:
                     self.mismatches += 1  # two blobs that are not the marker's two views

@@ -199,6 +199,7 @@ class StripMap:
         self.edges = [h * i // self.strips for i in range(self.strips + 1)]
         self.margin = params.block_size // 2 + params.median // 2
         self.next = 0  # the band the next frame matches; == strips: the map is complete
+        self.matched = 0  # bands matched since it was made (a frame matches at most one)
         self._map = np.empty((h, w), np.float32)
 
     @property
@@ -231,6 +232,7 @@ class StripMap:
             x0, hy0, x1, hy1 = hide
             self._map[max(y0, hy0):min(y1, hy1), x0:x1] = np.nan
         self.next += 1
+        self.matched += 1
         return None
 
 

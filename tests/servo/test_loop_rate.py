@@ -9,8 +9,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from host.servo import loop, perception
-from host.servo.loop import Servo
+from host.servo import perception
+from host.servo.loop import marker_disparity
 from host.servo.marker import find_marker
 from host.servo.perception import (
     StripMap,
@@ -75,24 +75,17 @@ def test_no_frame_of_the_robot_phase_matches_more_than_one_band(monkeypatch) -> 
     """Each frame matches at most one band of the re-measure's map (whole rows, the full
     search range), beside the marker's window and the lane ahead."""
     monkeypatch.setattr(perception, "STRIP_WORK", 1_000_000)  # four bands at 320x240 / 48
-    matched: list[tuple[int, int]] = []
-
-    def counting(left, right, params):
-        matched.append((left.shape[1], params.num_disparities))
-        return compute_disparity(left, right, params)
-
     with simulation(Setup((320, 240), 0.8)) as sim:
-        assert sim.servo._strips is not None and sim.servo._strips.strips == 4
-        monkeypatch.setattr(perception, "compute_disparity", counting)
-        monkeypatch.setattr(loop, "compute_disparity", counting)
+        strips = sim.servo.strips
+        assert strips is not None and strips.strips == 4
         remeasures = bands = 0
         for _ in range(75):  # 2.5 s: two re-measures
-            matched.clear()
-            before = sim.servo.tracker.history[:]
+            before, matched = sim.servo.tracker.history[:], strips.matched
             sim.step()
             remeasures += sim.servo.tracker.history != before
-            assert matched.count((320, 48)) <= 1
-            bands += matched.count((320, 48))
+            assert strips.matched - matched <= 1
+            bands += strips.matched - matched
+    assert sim.servo.strips is strips  # the same map all run: its count is every band
     assert remeasures >= 2 and bands >= 8
 
 
@@ -114,13 +107,11 @@ def test_vanished_target_stops_the_run_when_its_map_takes_several_frames(monkeyp
 
 @pytest.mark.parametrize("z", [0.5, 1.0, 2.0, 2.8])
 def test_marker_window_match_agrees_with_the_whole_map(z: float) -> None:
-    world, frame = _pair((640, 480), z)
+    _, frame = _pair((640, 480), z)
     pair = find_marker(frame.left, frame.right, radius_m=0.03, baseline_m=0.06)
     assert pair is not None
-    window = Servo(None, None, MatcherParams(), world.geometry)
-    whole = Servo(None, None, MatcherParams(), world.geometry, full_map=True)
-    d_window = window._robot_disparity(frame, pair)[0]
-    d_whole = whole._robot_disparity(frame, pair)[0]
+    d_window = marker_disparity(frame.left, frame.right, MatcherParams(), pair)[0]
+    d_whole = marker_disparity(frame.left, frame.right, MatcherParams(), pair, whole=True)[0]
     assert np.isfinite(d_window)
     assert d_window == pytest.approx(d_whole, abs=0.02)
     assert d_window == pytest.approx(pair.disparity, abs=1.0)
