@@ -91,8 +91,41 @@ SLOW_FILES = {
 }
 
 
+# Single tests in a slow tier while the rest of their file is fast: "file::name" (every
+# parametrization of it), or "file::name[id]" for one.
+SLOW_TESTS = {
+    "tests/firmware/test_races.py::test_a_link_loss_cut_is_never_undone_or_lost_wherever_the_tick_lands":
+        "an 1800-trial sweep in simavr",
+    "tests/firmware/test_races.py::test_the_clock_read_at_a_carry_is_never_torn_wherever_the_tick_lands":
+        "a 1500-trial sweep in simavr",
+    "tests/firmware/test_races.py::test_a_drive_acknowledged_at_the_deadline_is_still_driven":
+        "two 2500-trial sweeps in simavr",
+    "tests/sim/test_recover_events.py::test_a_knocked_camera_is_re_referenced_and_the_robot_holds":
+        "closed-loop runs",
+    "tests/sim/test_recover_events.py::test_a_reset_whose_boot_frame_is_lost_is_waited_out_and_the_robot_re_acquired":
+        "a closed-loop run",
+    "tests/sim/test_recover_events.py::test_a_box_put_down_in_the_lane_is_waited_out_and_the_target_taken_up_again":
+        "a closed-loop run",
+    "tests/sim/test_recover_events.py::test_a_box_left_in_the_lane_ends_the_run_after_the_lane_bound":
+        "a closed-loop run",
+    "tests/sim/test_recover_events.py::test_a_camera_knocked_more_often_than_the_bound_ends_the_run_with_its_reason":
+        "a closed-loop run",
+    "tests/stereo/test_sgm.py::test_sgm_in_steady_state_takes_no_page_faults":
+        "a fresh interpreter loading numba and matching 640x480 many times",
+    "tests/tuning/test_tune_cli.py::test_parallel_workers_give_the_same_result_as_one_process":
+        "worker processes that each load the matcher",
+}
+
+
+def _is_slow(rel: str, name: str) -> bool:
+    if any(rel == p or rel.startswith(p + "/") for p in SLOW_FILES):
+        return True
+    node = f"{rel}::{name}"
+    return node in SLOW_TESTS or node.split("[")[0] in SLOW_TESTS
+
+
 def pytest_collection_modifyitems(config, items) -> None:
     for item in items:
         rel = Path(str(item.fspath)).resolve().relative_to(ROOT).as_posix()
-        if any(rel == p or rel.startswith(p + "/") for p in SLOW_FILES):
+        if _is_slow(rel, item.name):
             item.add_marker(pytest.mark.slow)
