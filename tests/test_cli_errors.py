@@ -55,9 +55,11 @@ def ro(tmp_path: Path) -> Iterator[Path]:
     (tmp_path / "ro").chmod(0o755)
 
 
-@pytest.fixture()
-def files(tmp_path: Path) -> dict[str, Path]:
-    """Inputs good and bad, all inside tmp_path."""
+@pytest.fixture(scope="module")
+def files(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """Inputs good and bad, all in one folder (made once for the file: a test checks that the
+    folder is left as it was)."""
+    tmp_path = tmp_path_factory.mktemp("inputs")
     s = synthetic_scene(seed=5, width=160, height=120, max_disp=24)
     f = {name.split(".")[0]: tmp_path / name for name in (
         "l.png", "r.png", "colour.png", "small.png", "junk.png", "utf16.toml", "big.toml",
@@ -255,13 +257,16 @@ def test_bad_input_is_one_line_exit_2_and_writes_nothing(
         capsys: pytest.CaptureFixture[str]) -> None:
     names = {k: str(v) for k, v in files.items()} | {"tmp": str(tmp_path), "ro": str(ro)}
     fill = [a.format(**names) for a in argv]
-    before = _tree(tmp_path)
+    inputs = files["l"].parent
+    before, inputs_before = _tree(tmp_path), _tree(inputs)
     code, err = _run(fill, capsys)
     assert code == 2, err
     assert err.count("\n") == 1 and "Traceback" not in err, err
     assert words.format(**names) in err
     assert _tree(tmp_path) == before  # nothing written, nothing touched
-    assert not any(p.name.startswith(".") for p in tmp_path.rglob("*"))  # no temporaries
+    assert _tree(inputs) == inputs_before  # and the inputs (shared by the file's tests) as made
+    for root in (tmp_path, inputs):
+        assert not any(p.name.startswith(".") for p in root.rglob("*"))  # no temporaries
 
 
 def _scene(folder: Path, meta: object, blank: bool = False) -> Path:
