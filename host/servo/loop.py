@@ -46,7 +46,7 @@ from host.servo.controller import (
 from host.servo.deflicker import deflickered
 from host.servo.estimator import AGAINST, OUTSIDE, STILL, Estimator, EstimatorConfig, Sighting
 from host.servo.inputs import FrozenSensors, camera_moved, views_agree
-from host.servo.marker import RING_RATIO, MarkerPair, block_disparity, marker_candidates
+from host.servo.marker import RING_RATIO, MarkerPair, block_disparity, cut_views, marker_candidates
 from host.servo.perception import (
     Floor,
     StripMap,
@@ -122,6 +122,7 @@ class ServoConfig:
     min_area: int | None = None  # px; None: 1% of the image
     full_map: bool = False  # cross-check the marker on the whole map (tests)
     max_mismatch_px: float = 1.5  # block matching against the marker's centres
+    cut_mismatch_px: float = 0.35  # the same where the two views' discs differ (cut_views)
     remeasure_s: float = 1.0
     robot_half_width_m: float = 0.12  # the image region left out of the re-measure
     robot_below_marker_m: float = 0.22
@@ -211,6 +212,7 @@ class Servo:
         self.notes: list[str] = []  # what the servo decided and the user should know
         self.stop_reason = ""  # set when the run must end: by the servo itself, or request_stop
         self.mismatches = 0  # candidates block matching refused
+        self.cuts = 0  # candidates refused as a disc cut by something nearer (cut_views)
         self.observers: list[Observer] = []  # called with a Snapshot after every frame
         self.requested_stop: str | None = None  # why the user stopped the run (request_stop)
         self.flips = 0  # heading corrections by the motion check
@@ -376,6 +378,13 @@ class Servo:
                 if math.isfinite(block) and abs(block - pair.disparity) > cfg.max_mismatch_px:
                     self.mismatches += 1  # two blobs that are not the marker's two views
                     seen.rejected = seen.rejected or "its block matching disagrees"
+                    continue
+                cut = cut_views(pair)
+                if cut and not abs(block - pair.disparity) <= cfg.cut_mismatch_px:
+                    # a disc cut by a nearer edge, differently in each view: its centroids
+                    # do not give the card's disparity, and block matching does not confirm it
+                    self.cuts += 1
+                    seen.rejected = seen.rejected or f"{cut}: cut by something nearer"
                     continue
                 seen.pair, seen.rejected = pair, ""
                 return seen

@@ -247,3 +247,18 @@ def block_disparity(disp: np.ndarray, blob: Blob) -> float:
     values = disp[y0:y1, x0:x1][sel]
     values = values[np.isfinite(values)]
     return float(np.median(values)) if values.size else float("nan")
+
+
+def cut_views(pair: MarkerPair, aspect_tol: float = 0.12, radius_tol: float = 0.15) -> str:
+    """Why the pair's two discs are not one whole disc seen twice, "" if they may be. Something
+    nearer than the card across it (a box's edge, a post) is shifted against the card between
+    the views by the difference of their disparities, so it cuts the disc differently in each:
+    the cut view's disc is narrower (its width-to-height ratio, its radius) and its centroid
+    moves away from the edge, by a pixel of disparity at 2.7 m (seed 9's trial 419). A cut
+    along a row is the same in both views and moves no disparity."""
+    a, b = pair.left, pair.right
+    if abs(a.aspect - b.aspect) > aspect_tol:
+        return f"its two views' discs differ in shape ({a.aspect:.2f} and {b.aspect:.2f} wide)"
+    if abs(a.radius - b.radius) > radius_tol * max(a.radius, b.radius) + 0.25:
+        return f"its two views' discs differ in size ({a.radius:.2f} and {b.radius:.2f} px)"
+    return ""
