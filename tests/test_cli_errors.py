@@ -201,6 +201,8 @@ ROWS = [
     (SERVO + ["--min-duty", "700"], "--min-duty 700 exceeds --max-duty 600"),
     (["servo", "--sim", "--trial-index", "3"], "--trial-index goes with --trials N"),
     (["servo", "--sim", "--nominal", "--json", "{tmp}/t.json"], "--json goes with --trials N"),
+    (["servo", "--sim", "--trials", "3", "--log", "{tmp}/run.csv"],
+     "--log writes one run's log: not with --trials"),
     (["eval", "--scale", "0"], "argument --scale: must be > 0"),
     (["eval", "--rho", "-1"], "argument --rho: must be > 0"),
     (["tune", "--scale", "-4"], "argument --scale: must be > 0"),

@@ -155,6 +155,9 @@ def run(args: argparse.Namespace) -> int:
     if args.robot != "emulator" and not args.sim:
         raise HostError(f"--robot {args.robot} puts a simulated board in the simulated world: "
                         f"it needs --sim")
+    if args.log and args.trials:
+        raise HostError("--log writes one run's log: not with --trials (a row a trial goes to "
+                        "--csv, every trial to --json)")
     if args.log:
         check_output(args.log, "csv", "--log")
     if args.plot:
