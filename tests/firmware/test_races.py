@@ -25,9 +25,9 @@ def frame(seq: int, msg) -> str:
     return f"send {encode_frame(seq, *pack(msg)).hex()}"
 
 
-def sweep(harness, elf, before: list[str], n: int, after: list[str]) -> list[SimRun]:
-    """One SimRun per trial: the events before the sweep, then the trial's own. Trial k has an
-    extra tick after k instructions of `after` (harness.c)."""
+def _trial_lines(harness, elf, before: list[str], n: int, after: list[str]) -> list[list[str]]:
+    """The harness's output for each of the n trials of a sweep (harness.c), each with the
+    lines before the first trial (the events before the sweep)."""
     text = "\n".join([*before, f"sweep {n}", *after]) + "\n"
     out = subprocess.run([str(harness), str(elf)], input=text, capture_output=True, text=True,
                          timeout=600)
@@ -36,24 +36,24 @@ def sweep(harness, elf, before: list[str], n: int, after: list[str]) -> list[Sim
     starts = [i for i, line in enumerate(lines) if line.startswith("trial ")]
     assert len(starts) == n, f"{len(starts)} trials of {n}"
     prefix = lines[:starts[0]]
-    return [parse(prefix + lines[a:b]) for a, b in zip(starts, [*starts[1:], len(lines)])]
+    return [prefix + lines[a:b] for a, b in zip(starts, [*starts[1:], len(lines)])]
+
+
+def sweep(harness, elf, before: list[str], n: int, after: list[str]) -> list[SimRun]:
+    """One SimRun per trial: the events before the sweep, then the trial's own. Trial k has an
+    extra tick after k instructions of `after` (harness.c)."""
+    return [parse(t) for t in _trial_lines(harness, elf, before, n, after)]
 
 
 def forced_cycles(harness, elf, before: list[str], n: int, after: list[str]) -> list[tuple[int,
                                                                                         SimRun]]:
     """As sweep, each trial with the cycle at which its extra tick was raised (harness.c:
     "force CYCLE"; the CPU takes it as soon as interrupts are on)."""
-    text = "\n".join([*before, f"sweep {n}", *after]) + "\n"
-    out = subprocess.run([str(harness), str(elf)], input=text, capture_output=True, text=True,
-                         timeout=600)
-    assert out.returncode == 0, out.stderr[-500:]
-    lines = out.stdout.splitlines()
-    starts = [i for i, line in enumerate(lines) if line.startswith("trial ")]
-    assert len(starts) == n, f"{len(starts)} trials of {n}"
     trials = []
-    for a, b in zip(starts, [*starts[1:], len(lines)]):
-        force = next(int(x.split()[1]) for x in lines[a:b] if x.startswith("force "))
-        trials.append((force, parse(lines[:starts[0]] + lines[a:b])))
+    for t in _trial_lines(harness, elf, before, n, after):
+        trial = t[next(i for i, x in enumerate(t) if x.startswith("trial ")):]
+        force = next(int(x.split()[1]) for x in trial if x.startswith("force "))
+        trials.append((force, parse(t)))
     return trials
 
 
