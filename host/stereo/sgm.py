@@ -426,6 +426,36 @@ def _sweep(cl, crrev, vol, pl, prrev, term, S, C, P, M, crow, tot, forward, i0, 
                 S[y] = tot
 
 
+@njit(cache=True, inline="always")
+def _row_scratch(w, nd):
+    """What a pass that decides rows one at a time keeps beside them: the decision's candidate
+    indices (uint16, uint32) and sub-pixel rows, a row of minima, a zero row and the path
+    along the row's two pixel parities H (nd + 2, PAD at both ends)."""
+    idx = np.arange(nd + 1).astype(np.uint16)
+    jj = np.arange(nd + 1).astype(np.uint32)
+    fb = np.empty((4, w), dtype=np.float32)
+    mins = np.empty(w, dtype=np.uint16)
+    Z = np.zeros(nd + 2, dtype=np.uint16)
+    H = np.empty((2, nd + 2), dtype=np.uint16)
+    H[:, 0] = PAD
+    H[:, nd + 1] = PAD
+    return idx, jj, fb, mins, Z, H
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _from_the_right(crow, H, tot, mins, Z, p1, p2, nd):
+    """The path from the right, swept back along the row (its previous pixel in H): added to
+    the row's totals, each pixel's minimum total into mins."""
+    w = crow.shape[0]
+    m4 = np.uint16(0)
+    for t in range(w):
+        x = w - 1 - t
+        c = crow[x]
+        h4 = H[t % 2]
+        m4 = _start(h4, c, nd) if t == 0 else _step(H[1 - t % 2], m4, h4, c, p1, p2, nd)
+        mins[x] = _sum_into(tot[x], tot[x], h4, Z, Z, Z, nd, True)
+
+
 OVERLAP = 24  # rows the lower stripe of the 5-path pass starts above its first row
 
 
@@ -445,14 +475,7 @@ def _down(cl, crrev, vol, pl, prrev, term, S, P, M, crow, tot, y0, y1, warm, p1,
     """
     h, w = cl.shape
     nd = crow.shape[1]
-    idx = np.arange(nd + 1).astype(np.uint16)
-    jj = np.arange(nd + 1).astype(np.uint32)
-    fb = np.empty((4, w), dtype=np.float32)
-    mins = np.empty(w, dtype=np.uint16)
-    Z = np.zeros(nd + 2, dtype=np.uint16)
-    H = np.empty((2, nd + 2), dtype=np.uint16)
-    H[:, 0] = PAD
-    H[:, nd + 1] = PAD
+    idx, jj, fb, mins, Z, H = _row_scratch(w, nd)
     for i in range(y1 - y0 + warm):
         y = y0 - warm + i
         decided = i >= warm
@@ -484,13 +507,7 @@ def _down(cl, crrev, vol, pl, prrev, term, S, P, M, crow, tot, y0, y1, warm, p1,
             _sum_into(tot[x], Z, h0, d1, v2, d3, nd, False)
         if not decided:
             continue
-        m4 = np.uint16(0)
-        for t in range(w):
-            x = w - 1 - t
-            c = crow[x]
-            h4 = H[t % 2]
-            m4 = _start(h4, c, nd) if t == 0 else _step(H[1 - t % 2], m4, h4, c, p1, p2, nd)
-            mins[x] = _sum_into(tot[x], tot[x], h4, Z, Z, Z, nd, True)
+        _from_the_right(crow, H, tot, mins, Z, p1, p2, nd)
         _decide_row(tot, mins, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc,
                     acc16, sh, idx, jj, fb)
         if keep:
@@ -549,14 +566,7 @@ def _four(cl, crrev, vol, pl, prrev, term, S, y0, y1, K, ck, ckm, top, topm, BB,
     """
     h, w = cl.shape
     nd = ck.shape[2]
-    idx = np.arange(nd + 1).astype(np.uint16)
-    jj = np.arange(nd + 1).astype(np.uint32)
-    fb = np.empty((4, w), dtype=np.float32)
-    mins = np.empty(w, dtype=np.uint16)
-    Z = np.zeros(nd + 2, dtype=np.uint16)
-    H = np.empty((2, nd + 2), dtype=np.uint16)
-    H[:, 0] = PAD
-    H[:, nd + 1] = PAD
+    idx, jj, fb, mins, Z, H = _row_scratch(w, nd)
     P = np.empty((2, w, nd + 2), dtype=np.uint16)
     P[:, :, 0] = PAD
     P[:, :, nd + 1] = PAD
@@ -628,14 +638,7 @@ def _four(cl, crrev, vol, pl, prrev, term, S, y0, y1, K, ck, ckm, top, topm, BB,
                 m0 = _start(h0, c, nd) if x == 0 else _step(H[1 - x % 2], m0, h0, c, p1, p2,
                                                             nd)
                 _sum_into(tot[x], Z, h0, v, BB[r, x], Z, nd, False)
-            m4 = np.uint16(0)
-            for t in range(w):
-                x = w - 1 - t
-                c = crow[x]
-                h4 = H[t % 2]
-                m4 = _start(h4, c, nd) if t == 0 else _step(H[1 - t % 2], m4, h4, c, p1, p2,
-                                                            nd)
-                mins[x] = _sum_into(tot[x], tot[x], h4, Z, Z, Z, nd, True)
+            _from_the_right(crow, H, tot, mins, Z, p1, p2, nd)
             _decide_row(tot, mins, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc,
                         acc16, sh, idx, jj, fb)
             if keep:
