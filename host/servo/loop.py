@@ -525,11 +525,11 @@ class Servo:
             if not in_view(pair.left.u, pair.left.v, pair.left.radius * self.cfg.ring_ratio,
                            (w, h), scale, g.cx, g.cy):
                 return "the marker would leave the view: the robot is at the picture's edge"
+        if cmd.phase == "probe":  # a sighting not yet trusted (maybe a look-alike standing
+            return ""  # in the reference, its own body a fixed object); the probe is short
         duty = abs(cmd.left + cmd.right) / 2
         speed = max(abs(est.state.vz), est.cfg.max_speed_mps * duty / 1000)
         reach = stopping_distance_m(speed) + self.cfg.lane_margin_m
-        if cmd.phase == "probe":  # a sighting not yet trusted (maybe a look-alike standing
-            return ""  # in the reference, its own body a fixed object); the probe is short
         cfg = c.cfg
         ahead = fixed_in_path(c.others(), z, x, -1 if c.target_m < z else 1, reach,
                               cfg.half_width_m + cfg.block_margin_m / 2, cfg.cell_m)
