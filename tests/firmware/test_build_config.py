@@ -11,6 +11,8 @@ from pathlib import Path
 
 import pytest
 
+from host.emulator import pins
+
 ROOT = Path(__file__).resolve().parents[2]
 FW = ROOT / "firmware" / "atmega328"
 
@@ -38,6 +40,7 @@ def _number(text: str) -> int:
 def test_same_mcu_and_clock(make_config, pio) -> None:
     assert pio["env"]["board_build.mcu"] == make_config["MCU"]
     assert _number(pio["env"]["board_build.f_cpu"]) == _number(make_config["F_CPU"])
+    assert _number(make_config["F_CPU"]) == pins.F_CPU  # the simulated pins' and runs' clock
 
 
 def test_same_sources(make_config, pio) -> None:
