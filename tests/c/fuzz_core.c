@@ -2,8 +2,8 @@
  * mock board that checks the safety rules at every motor output, built with ASan and UBSan:
  *
  *   clang -fsanitize=fuzzer,address,undefined -Iprotocol/c tests/c/fuzz_core.c \
- *         firmware/atmega328/core/{robot,drive,link}.c firmware/atmega328/emu/single_thread.c \
- *         protocol/c/frame.c
+ *         firmware/atmega328/core/{robot,drive,link_loss}.c \
+ *         firmware/atmega328/emu/single_thread.c protocol/c/frame.c
  *
  * (tools/fuzz.py builds it; the board's lock and receive counter are the emulator's,
  * emu/single_thread.c: the fuzzer calls the core from one thread and hands it bytes straight.)
