@@ -26,7 +26,7 @@ PROTOCOL = ROOT / "protocol" / "c"
 TARGETS = {
     "parser": [ROOT / "tests/c/fuzz_parser.c", PROTOCOL / "frame.c"],
     "core": [ROOT / "tests/c/fuzz_core.c", FW / "core/robot.c", FW / "core/drive.c",
-             FW / "core/link.c", PROTOCOL / "frame.c"],
+             FW / "core/link_loss.c", FW / "emu/single_thread.c", PROTOCOL / "frame.c"],
 }
 FLAGS = ["-g", "-O1", "-std=gnu11", "-Wall", "-Wextra", "-Werror",
          "-fsanitize=fuzzer,address,undefined", "-fno-sanitize-recover=all"]

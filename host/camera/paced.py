@@ -6,14 +6,14 @@ by running fast."""
 from __future__ import annotations
 
 import time
-from typing import Any
 
 from host.camera.source import StereoFrame, StereoSource
+from host.camera.wrapper import WrappedSource
 
 LATE_S = 0.1  # a pair this much behind its pace restarts the pace from it
 
 
-class PacedSource(StereoSource):
+class PacedSource(WrappedSource):
     """inner at speed times real time (speed > 0); inner rectifies as it did. catch_up: a
     late pair does not restart the pace, the pairs after it come at once until the pace is
     kept again (as a camera's frames wait for a slow loop)."""
@@ -21,12 +21,10 @@ class PacedSource(StereoSource):
     def __init__(self, inner: StereoSource, speed: float = 1.0, catch_up: bool = False) -> None:
         if speed <= 0:
             raise ValueError("a paced source needs a speed above 0")
-        self.inner, self.speed, self.catch_up = inner, speed, catch_up
+        super().__init__(inner)
+        self.speed, self.catch_up = speed, catch_up
         self._t0: tuple[float, float] | None = None  # (first capture, wall time then)
         self.late = 0  # pairs handed on later than their pace (the loop was slower)
-
-    def __getattr__(self, name: str) -> Any:  # the inner source's own (clock, t, ...)
-        return getattr(self.inner, name)
 
     def _read(self) -> StereoFrame | None:
         frame = self.inner.read()
@@ -43,9 +41,3 @@ class PacedSource(StereoSource):
             if not self.catch_up:
                 self._t0 = (frame.t_left, now)
         return frame
-
-    def describe(self) -> dict[str, Any]:
-        return self.inner.describe()
-
-    def close(self) -> None:
-        self.inner.close()

@@ -24,11 +24,12 @@ from host.emulator.build import (
 
 def sources() -> list[Path]:
     """The firmware's register-free sources (its Makefile's SOURCES but the AVR layer's), with
-    the emulated board (firmware/atmega328/emu/board.c) in place of avr/."""
+    the emulated board (firmware/atmega328/emu: board.c and single_thread.c) in place of avr/."""
     avr = (FIRMWARE / "avr").resolve()
     portable = [p for p in firmware_sources() if avr not in p.parents]
     core = [p for p in portable if p.parent == (FIRMWARE / "core").resolve()]
-    return [*core, FIRMWARE / "emu" / "board.c", *(p for p in portable if p not in core)]
+    emu = [FIRMWARE / "emu" / "board.c", FIRMWARE / "emu" / "single_thread.c"]
+    return [*core, *emu, *(p for p in portable if p not in core)]
 
 
 def _headers() -> list[Path]:
@@ -49,8 +50,10 @@ def build_library() -> Path:
         return lib
     CACHE.mkdir(parents=True, exist_ok=True)
     tmp = lib.with_suffix(f".{os.getpid()}.tmp")
-    cmd = ["gcc", "-std=gnu11", "-O2", "-shared", "-fPIC", "-Wall", "-Wextra", "-Werror",
-           f"-I{PROTOCOL_C}", *map(str, srcs), "-o", str(tmp)]
+    # --no-undefined: a board function no source defines is a build error, not a crash when the
+    # core first calls it
+    cmd = ["gcc", "-std=gnu11", "-O2", "-shared", "-fPIC", "-Wl,--no-undefined", "-Wall",
+           "-Wextra", "-Werror", f"-I{PROTOCOL_C}", *map(str, srcs), "-o", str(tmp)]
     r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode:
         raise BuildFailed(f"building the firmware core failed: {r.stderr.strip()[:300]}")

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-F_CPU = 16_000_000
+F_CPU = 16_000_000  # the firmware Makefile's F_CPU (tests/firmware/test_build_config.py)
 PRESCALER = {0: 0, 1: 1, 2: 8, 3: 64, 4: 256, 5: 1024}  # CS12..CS10; 6, 7: external clock
 EN_BITS = {"left": 1, "right": 2}                        # PB1 = OC1A = ENA, PB2 = OC1B = ENB
 DIR_BITS = {"left": (4, 5), "right": (6, 7)}             # PD4/PD5 = IN1/IN2, PD6/PD7 = IN3/IN4
@@ -111,6 +111,11 @@ class Drive:
     cycle: int
     enable: Pin
     direction: str
+
+    @property
+    def driving(self) -> bool:
+        """The bridge gets power: its enable pin is an output with a duty above 0."""
+        return self.enable.driven and self.enable.duty > 0
 
 
 def timeline(ios: list[Io], motor: str) -> list[Drive]:

@@ -9,15 +9,16 @@ import subprocess
 import threading
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from host.emulator.board import MotorPins, WallClock
-from host.emulator.pins import Io
+from host.emulator.pins import F_CPU, Io
 from host.emulator.process import stop
 from host.link import protocol_gen as gen
 from host.link.frame import Frame, FrameDecoder, encode_frame
-from host.link.messages import pack
+from host.link.messages import pack, unpack
 
-F_CPU = 16_000_000
+CYCLES_PER_MS = F_CPU // 1000  # simulated time: CPU cycles in a millisecond
 CYCLES_PER_BYTE = 10 * F_CPU // gen.BAUD  # the harness feeds bytes at the host's line rate
 
 
@@ -46,6 +47,10 @@ class SimRun:
 
     def frames(self) -> list[Frame]:
         return FrameDecoder().feed(bytes(b for _, b in self.tx))
+
+    def messages(self) -> list[Any]:
+        """The firmware's frames as message objects (host.link.messages.unpack)."""
+        return [unpack(f.id, f.payload) for f in self.frames()]
 
     def settled(self) -> list[Pwm]:
         """Output changes with the transients dropped: the firmware writes OCR1A, then OCR1B a

@@ -19,7 +19,6 @@ from host.errors import HostError
 OPTIBOOT = Path("/usr/share/arduino/hardware/arduino/avr/bootloaders/optiboot/"
                 "optiboot_atmega328.hex")
 SOURCE = build.FIRMWARE / "simavr" / "uno.c"
-F_CPU = 16_000_000
 MCUSR_BITS = {0x01: "PORF", 0x02: "EXTRF", 0x04: "BORF", 0x08: "WDRF"}
 
 

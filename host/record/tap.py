@@ -14,6 +14,7 @@ import numpy as np
 from host.camera.calib_files import Calibration, ideal_calibration
 from host.camera.geometry import Geometry
 from host.camera.source import StereoFrame, StereoSource
+from host.camera.wrapper import WrappedSource
 from host.link import protocol_gen as gen
 from host.record import messages as m
 from host.record.writer import Message, Recorder
@@ -23,18 +24,16 @@ from host.servo.snapshot import Snapshot
 Search = Callable[[Snapshot], tuple[float, float]]  # the disparity range a map was searched in
 
 
-class RecordingSource(StereoSource):
+class RecordingSource(WrappedSource):
     """inner, its pairs recorded as they come (raw), then rectified as inner would have."""
 
     def __init__(self, inner: StereoSource, recorder: Recorder, geometry: Geometry) -> None:
-        self.inner, self.recorder = inner, recorder
+        super().__init__(inner)
+        self.recorder = recorder
         self.rectify, inner.rectify = inner.rectify, None
         self.calibration: Calibration | None = getattr(self.rectify, "calib", None)
         self._geometry = geometry
         self.last: StereoFrame | None = None  # the last pair read, raw
-
-    def __getattr__(self, name: str) -> Any:  # the inner source's own (clock, t, ...)
-        return getattr(self.inner, name)
 
     def _read(self) -> StereoFrame | None:
         frame = self.inner.read()
@@ -55,12 +54,6 @@ class RecordingSource(StereoSource):
 
         rec.put("frame", build)
         return frame
-
-    def describe(self) -> dict[str, Any]:
-        return self.inner.describe()
-
-    def close(self) -> None:
-        self.inner.close()
 
 
 def map_range(params: Any) -> Search:

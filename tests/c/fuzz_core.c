@@ -2,7 +2,11 @@
  * mock board that checks the safety rules at every motor output, built with ASan and UBSan:
  *
  *   clang -fsanitize=fuzzer,address,undefined -Iprotocol/c tests/c/fuzz_core.c \
- *         firmware/atmega328/core/{robot,drive,link}.c protocol/c/frame.c
+ *         firmware/atmega328/core/{robot,drive,link_loss}.c \
+ *         firmware/atmega328/emu/single_thread.c protocol/c/frame.c
+ *
+ * (tools/fuzz.py builds it; the board's lock and receive counter are the emulator's,
+ * emu/single_thread.c: the fuzzer calls the core from one thread and hands it bytes straight.)
  *
  * The input is a program of operations, one byte each (and its arguments):
  *   00xxxxxx  a well-formed frame: SEQ, then 4 bytes of payload; the message is xxxxxx % 8
@@ -104,21 +108,6 @@ void board_tx(const uint8_t *data, uint8_t n)
     if (data[3] == PROTO_MSG_NACK &&
         ++m.nacks > NACK_BURST + (m.now - m.start) / PROTO_DEFAULT_NACK_INTERVAL_MS)
         abort();
-}
-
-uint8_t board_lock(void)
-{
-    return 0;
-}
-
-void board_unlock(uint8_t state)
-{
-    (void)state;
-}
-
-uint16_t board_rx_overruns(void)
-{
-    return 0;
 }
 
 uint16_t board_tx_dropped(void)

@@ -26,17 +26,18 @@ def firmware(tmp_path, monkeypatch):
 
 def test_the_native_core_builds_the_makefiles_portable_sources(firmware):
     text = (firmware / "Makefile").read_text()
-    (firmware / "Makefile").write_text(text.replace("core/link.c", "core/link.c core/extra.c"))
+    (firmware / "Makefile").write_text(text.replace("core/drive.c", "core/drive.c core/extra.c"))
     sources = [p.resolve() for p in core.sources()]
     root = firmware.resolve()
     assert root / "core" / "extra.c" in sources
     assert root / "emu" / "board.c" in sources
+    assert root / "emu" / "single_thread.c" in sources
     assert not any(root / "avr" in p.parents for p in sources)  # no registers natively
 
 
 def test_the_checkouts_core_sources_are_its_makefiles_less_the_avr_layer():
     names = {p.name for p in core.sources()}
-    assert {"robot.c", "drive.c", "link.c", "board.c", "frame.c"} <= names
+    assert {"robot.c", "drive.c", "link_loss.c", "board.c", "single_thread.c", "frame.c"} <= names
     assert not names & {"main.c", "uart.c", "clock.c", "motors.c", "reset.c"}
 
 

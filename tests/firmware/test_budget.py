@@ -6,12 +6,12 @@ from __future__ import annotations
 
 import subprocess
 
-from host.emulator.simavr import CYCLES_PER_BYTE, F_CPU, Script, flood
+from host.emulator.simavr import CYCLES_PER_BYTE, Script, flood
 from host.link import protocol_gen as gen
+from tests.firmware.common import MS
 
 FLASH_BUDGET = 4096
 RAM_BUDGET = 384
-MS = F_CPU // 1000
 
 
 def _size(elf) -> tuple[int, int]:

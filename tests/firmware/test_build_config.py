@@ -1,5 +1,6 @@
 """platformio.ini and firmware/atmega328/Makefile build the same thing (PlatformIO cannot fetch
-its platform here, so the agreement is checked on the two files)."""
+its platform here, so the agreement is checked on the two files), and the simulators run it at
+the Makefile's clock (host/emulator/pins.py's F_CPU, simavr/common.h's)."""
 
 from __future__ import annotations
 
@@ -10,6 +11,8 @@ import subprocess
 from pathlib import Path
 
 import pytest
+
+from host.emulator import pins
 
 ROOT = Path(__file__).resolve().parents[2]
 FW = ROOT / "firmware" / "atmega328"
@@ -38,6 +41,9 @@ def _number(text: str) -> int:
 def test_same_mcu_and_clock(make_config, pio) -> None:
     assert pio["env"]["board_build.mcu"] == make_config["MCU"]
     assert _number(pio["env"]["board_build.f_cpu"]) == _number(make_config["F_CPU"])
+    assert _number(make_config["F_CPU"]) == pins.F_CPU  # the simulated pins' and runs' clock
+    common = (FW / "simavr" / "common.h").read_text()  # the clock simavr runs the ELF at
+    assert re.findall(r"^#define F_CPU (\w+)$", common, re.MULTILINE) == [make_config["F_CPU"]]
 
 
 def test_same_sources(make_config, pio) -> None:

@@ -9,30 +9,9 @@ from __future__ import annotations
 import pytest
 
 from host.emulator.pins import Pin, enable_pin, timeline
-from host.emulator.simavr import CYCLES_PER_BYTE, F_CPU, FLOODS, Script, flood, run
+from host.emulator.simavr import CYCLES_PER_BYTE, FLOODS, Script, flood, run
 from host.link import protocol_gen as gen
-from host.link.frame import encode_frame
-from host.link.messages import pack, unpack
-
-MS = F_CPU // 1000
-
-
-def first(items, what: str = "the expected event"):
-    """The first of items; a failed assertion (not StopIteration) when there is none: what the
-    test waits for never happened, which is the firmware's behaviour, not the test's."""
-    for x in items:
-        return x
-    raise AssertionError(f"never happened: {what}")
-NO_RAMP = gen.SetConfig(link_timeout_ms=gen.DEFAULT_LINK_TIMEOUT_MS, accel_limit=0)
-FRAME = len(encode_frame(0, *pack(NO_RAMP)))  # bytes of a SET_CONFIG or SET_DRIVE frame
-
-
-def messages(r):
-    return [unpack(f.id, f.payload) for f in r.frames()]
-
-
-def driving(d) -> bool:
-    return d.enable.driven and d.enable.duty > 0
+from tests.firmware.common import FRAME, MS, NO_RAMP, first
 
 
 def test_pwm_at_the_enable_pins_is_20_khz_with_the_commanded_duty(harness, firmware_elf):
@@ -48,7 +27,7 @@ def test_pins_from_reset_through_init_never_drive_the_bridge(harness, firmware_e
     r = run(harness, firmware_elf, Script().run_ms(5))
     for motor in ("left", "right"):
         for d in timeline(r.io, motor):
-            assert not driving(d) and d.direction in ("floating", "off"), (motor, d)
+            assert not d.driving and d.direction in ("floating", "off"), (motor, d)
     last = r.io[-1]
     # after init: enables are outputs wired to Timer1 (mode 10, no prescaler, TOP 400) at 0 %
     assert last.wgm == 10 and last.prescaler == 1 and last.icr1 == 400
@@ -58,7 +37,7 @@ def test_pins_from_reset_through_init_never_drive_the_bridge(harness, firmware_e
     # the motors are set up first: the bridge inputs are low outputs within 0.2 ms of reset
     set_up = first(io for io in r.io if io.ddrd & 0xF0 == 0xF0)
     assert set_up.cycle < 0.2 * MS and set_up.portd & 0xF0 == 0
-    assert messages(r)[0].NAME == "BOOT"
+    assert r.messages()[0].NAME == "BOOT"
 
 
 def test_a_watchdog_reset_disables_the_watchdog_before_the_c_runtime_runs(harness, hang_elf):
@@ -73,15 +52,15 @@ def test_a_watchdog_reset_disables_the_watchdog_before_the_c_runtime_runs(harnes
     armed = first(io for io in after if io.cycle > cleared.cycle and io.wdtcsr & 0x08)
     motors_set_up = first(io for io in after if io.ddrd & 0xF0 == 0xF0)
     assert armed.cycle > motors_set_up.cycle  # main arms it after the motors are off
-    assert all(not driving(d) for d in timeline(after, "left"))
+    assert all(not d.driving for d in timeline(after, "left"))
 
 
 def reversal(r, motor: str, was: str, becomes: str) -> tuple[float, list, list]:
     """Dead interval in ms between the last driven instant in direction was and the first
     driven instant in direction becomes, the states in between, and those after."""
     t = timeline(r.io, motor)
-    was_on = [i for i, d in enumerate(t) if driving(d) and d.direction == was]
-    becomes_on = [i for i, d in enumerate(t) if driving(d) and d.direction == becomes]
+    was_on = [i for i, d in enumerate(t) if d.driving and d.direction == was]
+    becomes_on = [i for i, d in enumerate(t) if d.driving and d.direction == becomes]
     assert was_on and becomes_on, f"{motor} never driven {was} and then {becomes}"
     end, start = max(was_on), min(becomes_on)
     assert end < start
@@ -101,7 +80,7 @@ def test_reversal_goes_through_zero_and_coasts_before_the_bridge_is_driven_again
     for motor in ("left", "right"):
         dead_ms, between, after = reversal(r, motor, was, becomes)
         # the direction inputs change only while the enable is off (duty 0 in force at the pin)
-        assert between and all(not driving(d) for d in between), motor
+        assert between and all(not d.driving for d in between), motor
         assert gen.DEFAULT_REVERSE_COAST_MS <= dead_ms < gen.DEFAULT_REVERSE_COAST_MS + 2, motor
         assert timeline(r.io, motor)[-1].enable == Pin(True, 0.6, 20_000.0)
         if ramp:  # the new direction is ramped too, from zero at the acceleration limit
@@ -116,7 +95,7 @@ def test_the_default_ramp_takes_duty_up_at_the_acceleration_limit(harness, firmw
     r = run(harness, firmware_elf, Script().run_ms(2)
             .message(1, gen.SetDrive(left=600, right=0)).run_ms(200))
     t = [d for d in timeline(r.io, "left") if d.cycle > r.last_in_done()]
-    start = first(d for d in t if driving(d))
+    start = first(d for d in t if d.driving)
     full = first(d for d in t if d.enable.duty == 0.6)
     ramp_ms = (full.cycle - start.cycle) / MS
     expected = 600 / (gen.DEFAULT_ACCEL_LIMIT / 100)  # permille / (permille per ms)
@@ -136,20 +115,20 @@ def test_the_motors_stop_250_ms_after_the_last_accepted_drive_whatever_follows(
     r = run(harness, firmware_elf, s)
     drive_done = r.ins[2 * FRAME - 1][0] + CYCLES_PER_BYTE  # the SET_DRIVE's stop bit
     t = [d for d in timeline(r.io, "left") if d.cycle > drive_done]
-    on = first(i for i, d in enumerate(t) if driving(d))
-    off = first(d for d in t[on:] if not driving(d))
+    on = first(i for i, d in enumerate(t) if d.driving)
+    off = first(d for d in t[on:] if not d.driving)
     stop_ms = (off.cycle - drive_done) / MS
     assert gen.DEFAULT_LINK_TIMEOUT_MS <= stop_ms < gen.DEFAULT_LINK_TIMEOUT_MS + 2, stop_ms
-    assert all(not driving(d) for d in t if d.cycle > off.cycle)
+    assert all(not d.driving for d in t if d.cycle > off.cycle)
     assert r.resets == []
-    status = messages(r)[-1]
+    status = r.messages()[-1]
     assert status.NAME == "STATUS" and status.flags & gen.StatusFlag.LINK_LOST
     assert not status.flags & gen.StatusFlag.DRIVING and (status.left, status.right) == (0, 0)
     if kind != "quiet":  # faster than simavr's UART takes bytes: it overran, and it was counted
         assert status.rx_overruns > 0
     if kind == "get-status":  # 30-byte answers to 6-byte polls: dropped, never waited for
         assert status.tx_dropped > 0
-    nacks = sum(m.NAME == "NACK" for m in messages(r))
+    nacks = sum(m.NAME == "NACK" for m in r.messages())
     flood_ms = 520  # NACKs are rate-limited: a burst, then one per interval
     assert nacks <= 4 + flood_ms / gen.DEFAULT_NACK_INTERVAL_MS + 1, nacks
     if kind in ("bad-crc", "refused"):  # but they still come, one per interval
@@ -162,7 +141,7 @@ def test_bytes_that_pile_up_while_the_main_loop_stalls_are_counted_as_overruns(
     s = Script().run_ms(2).message(1, gen.SetDrive(left=997, right=-25)).run_ms(1)
     s.send(flood("get-status", 300)).run_ms(40).message(2, gen.GetStatus()).run_ms(10)
     r = run(harness, hang_elf, s)
-    status = messages(r)[-1]
+    status = r.messages()[-1]
     assert status.NAME == "STATUS" and r.resets == []
     assert status.rx_overruns > 0  # the receive ring filled up during the stall
 
@@ -177,7 +156,7 @@ def test_a_new_command_with_the_seq_of_an_old_one_is_applied_not_taken_for_a_res
         s.message(seq & 0xFF, gen.GetStatus())
     s.message(10, gen.SetDrive(left=-300, right=-300)).run_ms(300)
     r = run(harness, firmware_elf, s)
-    acks = [m for m in messages(r) if m.NAME == "ACK" and m.seq == 10]
+    acks = [m for m in r.messages() if m.NAME == "ACK" and m.seq == 10]
     assert [a.result for a in acks] == [gen.AckResult.APPLIED, gen.AckResult.APPLIED]
     last = timeline(r.io, "left")[-1]
     assert last.direction == "reverse" and last.enable.duty == 0.3

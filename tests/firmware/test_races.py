@@ -14,9 +14,8 @@ from host.emulator.pins import timeline
 from host.emulator.simavr import CYCLES_PER_BYTE, F_CPU, SimRun, parse
 from host.link import protocol_gen as gen
 from host.link.frame import encode_frame
-from host.link.messages import pack, unpack
+from host.link.messages import pack
 
-MS = F_CPU // 1000
 DRIVE = gen.SetDrive(left=500, right=500)
 PWM_PERIOD = F_CPU // 20_000  # cycles: a new OCR1x takes effect at the PWM's next TOP
 
@@ -57,10 +56,6 @@ def forced_cycles(harness, elf, before: list[str], n: int, after: list[str]) -> 
     return trials
 
 
-def messages(r: SimRun) -> list:
-    return [unpack(f.id, f.payload) for f in r.frames()]
-
-
 def frame_cycles(r: SimRun) -> list[int]:
     """The cycle at which each frame the firmware sent began (its START byte on the line)."""
     out, i = [], 0
@@ -75,7 +70,7 @@ def frame_cycles(r: SimRun) -> list[int]:
 
 def status_of(r: SimRun):
     """The STATUS the trial's GET_STATUS was answered with (None: no answer, a failure)."""
-    return next((m for m in messages(r) if m.NAME == "STATUS"), None)
+    return next((m for m in r.messages() if m.NAME == "STATUS"), None)
 
 
 def driven_spans(r: SimRun, motor: str, after: int) -> list[tuple[int, int]]:
@@ -140,7 +135,7 @@ def test_the_clock_read_at_a_carry_is_never_torn_wherever_the_tick_lands(
     trials = sweep(harness, firmware_elf, before, 1500, after)
     bad = []
     for k, r in enumerate(trials):
-        ms = messages(r)
+        ms = r.messages()
         status = status_of(r)
         acked = [m.result for m in ms if m.NAME == "ACK" and m.seq == 1]
         spans = [driven_spans(r, motor, 0) for motor in ("left", "right")]
@@ -164,7 +159,7 @@ def test_a_drive_acknowledged_at_the_deadline_is_still_driven(harness, firmware_
     trials = sweep(harness, firmware_elf, before, 2500, after)
     bad = []
     for k, r in enumerate(trials):
-        acks = [(c, m) for c, m in zip(frame_cycles(r), messages(r))
+        acks = [(c, m) for c, m in zip(frame_cycles(r), r.messages())
                 if m.NAME == "ACK" and m.seq == seq]
         ack_at, ack = acks[-1]
         status = status_of(r)

@@ -10,21 +10,11 @@ import subprocess
 import pytest
 
 from host.emulator.pins import timeline
-from host.emulator.simavr import CYCLES_PER_BYTE, F_CPU, Script, run
+from host.emulator.simavr import CYCLES_PER_BYTE, Script, run
 from host.link import protocol_gen as gen
 from host.link.frame import encode_frame
-from host.link.messages import pack, unpack
-
-MS = F_CPU // 1000
-
-
-def first(items, what: str = "the expected event"):
-    """The first of items; a failed assertion (not StopIteration) when there is none: what the
-    test waits for never happened, which is the firmware's behaviour, not the test's."""
-    for x in items:
-        return x
-    raise AssertionError(f"never happened: {what}")
-NO_RAMP = gen.SetConfig(link_timeout_ms=gen.DEFAULT_LINK_TIMEOUT_MS, accel_limit=0)
+from host.link.messages import pack
+from tests.firmware.common import MS, NO_RAMP, first
 
 
 class Plan:
@@ -59,24 +49,16 @@ def done(r, plan: Plan, mark: str) -> int:
     return r.ins[plan.marks[mark]][0] + CYCLES_PER_BYTE
 
 
-def driving(d) -> bool:
-    return d.enable.driven and d.enable.duty > 0
-
-
 def stops_after(r, cycle: int, motor: str = "left") -> float:
     """ms from cycle to the first instant the motor's bridge is off, having been driven."""
     t = [d for d in timeline(r.io, motor) if d.cycle > cycle]
-    on = first(i for i, d in enumerate(t) if driving(d))
-    off = first(d for d in t[on:] if not driving(d))
+    on = first(i for i, d in enumerate(t) if d.driving)
+    off = first(d for d in t[on:] if not d.driving)
     return (off.cycle - cycle) / MS
 
 
-def messages(r):
-    return [unpack(f.id, f.payload) for f in r.frames()]
-
-
 def acks(r, seq: int) -> list[int]:
-    return [m.result for m in messages(r) if m.NAME == "ACK" and m.seq == seq]
+    return [m.result for m in r.messages() if m.NAME == "ACK" and m.seq == seq]
 
 
 # --- link loss ---
@@ -137,8 +119,7 @@ def test_after_a_link_loss_stop_the_same_drive_is_applied_again(harness, firmwar
     r = run(harness, firmware_elf, p.script)
     assert acks(r, 7) == [gen.AckResult.APPLIED, gen.AckResult.APPLIED]
     last = timeline(r.io, "left")[-1]
-    assert driving(last) and last.enable.duty == 0.5
-
+    assert last.driving and last.enable.duty == 0.5
 
 
 def test_after_a_link_loss_stop_a_resent_set_config_is_applied(harness, firmware_elf) -> None:
@@ -161,8 +142,8 @@ def test_stop_then_reverse_coasts_before_the_bridge_is_driven_again(harness, fir
     r = run(harness, firmware_elf, p.script)
     for motor in ("left", "right"):
         t = timeline(r.io, motor)
-        off = first(d for d in t if d.cycle > done(r, p, "stop") - 100 and not driving(d))
-        back = first(d for d in t if d.cycle > off.cycle and driving(d))
+        off = first(d for d in t if d.cycle > done(r, p, "stop") - 100 and not d.driving)
+        back = first(d for d in t if d.cycle > off.cycle and d.driving)
         assert back.direction == "reverse"
         assert (back.cycle - off.cycle) / MS >= gen.DEFAULT_REVERSE_COAST_MS, motor
 
@@ -183,7 +164,7 @@ def test_set_config_limits_are_enforced_on_the_wire(harness, firmware_elf) -> No
     for seq, (timeout, accel, _) in enumerate(cases):
         p.send(_set_config(seq, timeout, accel)).run(3)
     r = run(harness, firmware_elf, p.script)
-    replies = {m.seq: m for m in messages(r) if m.NAME in ("ACK", "NACK")}
+    replies = {m.seq: m for m in r.messages() if m.NAME in ("ACK", "NACK")}
     for seq, (timeout, accel, ok) in enumerate(cases):
         want = (gen.Ack(seq=seq, result=gen.AckResult.APPLIED) if ok
                 else gen.Nack(seq=seq, error=gen.Error.OUT_OF_RANGE))
@@ -256,7 +237,7 @@ def _boot_causes(harness, elf, *before: str, after: tuple[str, ...] = ()) -> lis
         p.line(line)
     p.run(5)
     r = run(harness, elf, p.script)
-    return [m.reset_cause for m in messages(r) if m.NAME == "BOOT"]
+    return [m.reset_cause for m in r.messages() if m.NAME == "BOOT"]
 
 
 MCUSR_CLEARED = "poke 54 00"  # what the application sees behind optiboot 4.4
@@ -316,7 +297,7 @@ def test_a_flood_of_nested_false_frames_causes_no_watchdog_reset(harness, firmwa
     p.msg(2, gen.GetStatus()).run(10)
     r = run(harness, firmware_elf, p.script)
     assert r.resets == []
-    status = messages(r)[-1]
+    status = r.messages()[-1]
     assert status.NAME == "STATUS" and status.rx_overruns > 0
     assert status.flags & gen.StatusFlag.LINK_LOST
 
@@ -330,7 +311,7 @@ def test_a_burst_during_a_short_stall_is_held_by_the_receive_ring(harness, hang_
         p.msg(seq, gen.SetDrive(left=100 * seq, right=100 * seq))
     p.run(25).line("flow 1").msg(6, gen.GetStatus()).run(10)
     r = run(harness, hang_elf, p.script)
-    got = messages(r)
+    got = r.messages()
     assert [m.seq for m in got if m.NAME == "ACK"] == [0, 1, 2, 3, 4, 5]
     assert got[-1].NAME == "STATUS" and got[-1].rx_overruns == 0
 
@@ -350,9 +331,9 @@ def test_a_false_start_on_the_line_does_not_swallow_the_keepalives(harness, firm
     p.msg(2, gen.GetStatus()).run(5)
     r = run(harness, firmware_elf, p.script)
     t = [d for d in timeline(r.io, "left") if d.cycle > done(r, p, "drive")]
-    on = first(i for i, d in enumerate(t) if driving(d))
-    assert all(driving(d) for d in t[on:]), "the motors were cut"
-    status = messages(r)[-1]
+    on = first(i for i, d in enumerate(t) if d.driving)
+    assert all(d.driving for d in t[on:]), "the motors were cut"
+    status = r.messages()[-1]
     assert status.NAME == "STATUS" and status.link_losses == 0
     assert not status.flags & gen.StatusFlag.LINK_LOST and status.framing_errors == 1
 
@@ -364,7 +345,7 @@ def test_a_frame_with_gaps_between_its_bytes_is_dropped(harness, firmware_elf) -
         p.send(bytes([b])).run(gen.DEFAULT_FRAME_GAP_MS + 2)
     p.msg(4, gen.GetStatus()).run(5).msg(5, gen.SetDrive(left=300, right=300)).run(5)
     r = run(harness, firmware_elf, p.script)
-    got = messages(r)
+    got = r.messages()
     assert [m.seq for m in got if m.NAME == "ACK"] == [0, 5]  # the gapped frame never counted
     status = first(m for m in got if m.NAME == "STATUS")
     assert status.framing_errors >= 1 and status.left == 0
@@ -377,6 +358,6 @@ def test_status_counts_every_link_loss_stop(harness, firmware_elf) -> None:
         p.msg(seq, gen.SetDrive(left=300, right=300)).run(gen.DEFAULT_LINK_TIMEOUT_MS + 20)
     p.msg(3, gen.SetDrive(left=300, right=300)).run(5).msg(4, gen.GetStatus()).run(5)
     r = run(harness, firmware_elf, p.script)
-    status = messages(r)[-1]
+    status = r.messages()[-1]
     assert status.NAME == "STATUS" and status.link_losses == 2
     assert not status.flags & gen.StatusFlag.LINK_LOST  # cleared by the last SET_DRIVE

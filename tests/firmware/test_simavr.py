@@ -12,30 +12,15 @@ from host.emulator.simavr import CYCLES_PER_BYTE, F_CPU, Script, run
 from host.link import protocol_gen as gen
 from host.link.frame import encode_frame
 from host.link.messages import describe, pack, unpack
+from tests.firmware.common import MS, NO_RAMP, first
 
-MS = F_CPU // 1000
-
-
-def first(items, what: str = "the expected event"):
-    """The first of items; a failed assertion (not StopIteration) when there is none: what the
-    test waits for never happened, which is the firmware's behaviour, not the test's."""
-    for x in items:
-        return x
-    raise AssertionError(f"never happened: {what}")
 ROOT = Path(__file__).resolve().parents[2]
-
-
-NO_RAMP = gen.SetConfig(link_timeout_ms=gen.DEFAULT_LINK_TIMEOUT_MS, accel_limit=0)
-
-
-def messages(r):
-    return [unpack(f.id, f.payload) for f in r.frames()]
 
 
 def test_boot_and_hello_report_schema_hash_and_power_on(harness, firmware_elf) -> None:
     r = run(harness, firmware_elf, Script().run_ms(5).message(1, gen.Hello(nonce=0xC0FFEE))
             .run_ms(10))
-    boot, reply = messages(r)
+    boot, reply = r.messages()
     assert boot == gen.Boot(reset_cause=gen.ResetCause.POWER_ON, fw_version=0x0100,
                             schema_hash=gen.SCHEMA_HASH)
     assert reply.nonce == 0xC0FFEE and reply.schema_hash == gen.SCHEMA_HASH
@@ -53,7 +38,7 @@ def test_set_drive_sets_compare_registers_and_direction_pins(harness, firmware_e
     applied = first(p for p in r.pwm if p.cycle > r.last_in_done())
     latency = applied.cycle - r.last_in_done()
     assert 0 < latency < 4000, f"{latency} cycles from the last byte's stop bit to the PWM"
-    assert messages(r)[-1] == gen.Ack(seq=1, result=gen.AckResult.APPLIED)
+    assert r.messages()[-1] == gen.Ack(seq=1, result=gen.AckResult.APPLIED)
 
 
 def test_set_config_changes_the_link_timeout(harness, firmware_elf) -> None:
@@ -76,7 +61,7 @@ def test_garbage_and_corrupted_frames_are_refused_and_the_next_frame_works(
               .send(encode_frame(4, 0x7E, b"\x01")).run_ms(5)
               .message(5, gen.SetDrive(left=250, right=250)).run_ms(10))
     r = run(harness, firmware_elf, script)
-    replies = messages(r)[2:]
+    replies = r.messages()[2:]
     assert gen.Nack(seq=3, error=gen.Error.BAD_CRC) in replies
     assert gen.Nack(seq=4, error=gen.Error.UNKNOWN_ID) in replies
     assert replies[-1] == gen.Ack(seq=5, result=gen.AckResult.APPLIED)
@@ -87,7 +72,7 @@ def test_a_resent_command_is_acknowledged_but_not_applied_twice(harness, firmwar
     s = Script().run_ms(2).message(7, gen.SetDrive(left=300, right=300)).run_ms(5)
     s.message(7, gen.SetDrive(left=300, right=300)).run_ms(5)
     r = run(harness, firmware_elf, s)
-    assert messages(r)[1:] == [gen.Ack(seq=7, result=gen.AckResult.APPLIED),
+    assert r.messages()[1:] == [gen.Ack(seq=7, result=gen.AckResult.APPLIED),
                                gen.Ack(seq=7, result=gen.AckResult.DUPLICATE)]
 
 
@@ -109,7 +94,7 @@ def test_watchdog_resets_a_hung_firmware_with_the_motors_off(harness, hang_elf) 
     assert 28 <= (stopped.cycle - hang_start) / MS <= 36
     after = [p for p in r.pwm if p.cycle >= stopped.cycle]
     assert all(p.ocr1a == p.ocr1b == 0 for p in after)
-    msgs = messages(r)
+    msgs = r.messages()
     boots = [m for m in msgs if isinstance(m, gen.Boot)]
     assert [b.reset_cause for b in boots] == [gen.ResetCause.POWER_ON, gen.ResetCause.WATCHDOG]
     hello = first(m for m in msgs if isinstance(m, gen.HelloReply))
@@ -126,7 +111,7 @@ def test_ten_seconds_of_line_rate_traffic_cause_no_watchdog_reset(harness, firmw
     r = run(harness, firmware_elf, Script().quiet().run_ms(1).send(data).run_ms(10_200))
     assert r.resets == []
     assert r.n_in == len(data) and r.end_cycle / F_CPU > 10
-    acks = [m for m in messages(r) if isinstance(m, gen.Ack)]
+    acks = [m for m in r.messages() if isinstance(m, gen.Ack)]
     assert len(acks) == n and all(a.result == gen.AckResult.APPLIED for a in acks)
 
 

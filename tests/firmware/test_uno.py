@@ -14,14 +14,14 @@ import pytest
 
 from host.emulator import build
 from host.emulator.emulator import Emulator, PtyService
-from host.emulator.uno import F_CPU, SimulatedUno, avrdude, hex_image
+from host.emulator.uno import SimulatedUno, avrdude, hex_image
 from host.link import protocol_gen as gen
 from host.link.client import LinkError, RobotLink
 from host.link.frame import encode_frame
 from host.link.messages import pack
+from tests.firmware.common import MS
 
 ROOT = build.ROOT
-MS = F_CPU // 1000
 
 
 def _hex(test_hang: bool = False) -> Path:

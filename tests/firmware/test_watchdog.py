@@ -9,30 +9,11 @@ from __future__ import annotations
 import pytest
 
 from host.emulator.pins import timeline
-from host.emulator.simavr import CYCLES_PER_BYTE, F_CPU, Script, run
+from host.emulator.simavr import CYCLES_PER_BYTE, Script, run
 from host.link import protocol_gen as gen
-from host.link.frame import encode_frame
-from host.link.messages import pack, unpack
+from tests.firmware.common import FRAME, MS, first
 
-MS = F_CPU // 1000
-
-
-def first(items, what: str = "the expected event"):
-    """The first of items; a failed assertion (not StopIteration) when there is none: what the
-    test waits for never happened, which is the firmware's behaviour, not the test's."""
-    for x in items:
-        return x
-    raise AssertionError(f"never happened: {what}")
 CONFIG = gen.SetConfig(link_timeout_ms=5000, accel_limit=0)  # no link-loss stop, no ramp
-FRAME = len(encode_frame(0, *pack(CONFIG)))
-
-
-def driving(d) -> bool:
-    return d.enable.driven and d.enable.duty > 0
-
-
-def messages(r):
-    return [unpack(f.id, f.payload) for f in r.frames()]
 
 
 @pytest.fixture(scope="module")
@@ -71,10 +52,10 @@ def test_a_stall_between_one_and_two_periods_ends_in_a_watchdog_reset(
     reset = r.resets[0]
     assert (reset - start) / MS <= 2 * period_ms + 4
     left = timeline(r.io, "left")
-    stop = first(d for d in left if d.cycle > start and not driving(d))
+    stop = first(d for d in left if d.cycle > start and not d.driving)
     assert (stop.cycle - start) / MS <= period_ms + 4
-    assert not any(driving(d) for d in left if d.cycle > stop.cycle)
-    msgs = messages(r)
+    assert not any(d.driving for d in left if d.cycle > stop.cycle)
+    msgs = r.messages()
     assert [m.reset_cause for m in msgs if m.NAME == "BOOT"] == [gen.ResetCause.POWER_ON,
                                                                 gen.ResetCause.WATCHDOG]
     assert first(m for m in msgs if m.NAME == "STATUS").flags & gen.StatusFlag.WATCHDOG_RESET
@@ -92,13 +73,13 @@ def test_a_hang_with_interrupts_off_stops_the_motors_within_two_periods(
     assert (r.resets[0] - start) / MS <= 2 * period_ms + 4
     # motors driven until the reset (nothing can cut them earlier), never after it
     left = timeline(r.io, "left")
-    assert not any(driving(d) for d in left if d.cycle > r.resets[0])
-    assert [m.reset_cause for m in messages(r) if m.NAME == "BOOT"][-1] == \
+    assert not any(d.driving for d in left if d.cycle > r.resets[0])
+    assert [m.reset_cause for m in r.messages() if m.NAME == "BOOT"][-1] == \
         gen.ResetCause.WATCHDOG
 
 
 def test_a_stall_shorter_than_a_period_is_no_reset(harness, hang_elf, period_ms) -> None:
     r, start = stall_run(harness, hang_elf, 997, -(period_ms // 2), period_ms)
     assert r.resets == []
-    assert messages(r)[-1].NAME == "STATUS"
-    assert driving(timeline(r.io, "left")[-1])
+    assert r.messages()[-1].NAME == "STATUS"
+    assert timeline(r.io, "left")[-1].driving

@@ -6,10 +6,11 @@ does not depend on where the search starts."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
-from host.servo import perception
 from host.servo.loop import marker_disparity
 from host.servo.marker import find_marker
 from host.servo.perception import (
@@ -26,6 +27,9 @@ from host.sim.world import Box, World
 from host.stereo import MatcherParams, compute_disparity
 
 ALONE = (Box(1.2, -0.50, -0.18, 0.38),)  # the target box and nothing else: no next object
+# The camera's size and search range, where the re-measure's map takes four frames as it is
+# (perception.STRIP_WORK); at the simulation's usual 320x240 / 48 it takes one.
+CAMERA = dict(size=(640, 480), params=replace(Setup.params, num_disparities=64))
 
 
 def _pair(size=(320, 240), z=1.6, seed=5):
@@ -71,11 +75,10 @@ def test_matchers_that_are_not_row_local_get_the_whole_map_in_one_frame(matcher:
     assert strips.strips == 1
 
 
-def test_no_frame_of_the_robot_phase_matches_more_than_one_band(monkeypatch) -> None:
+def test_no_frame_of_the_robot_phase_matches_more_than_one_band() -> None:
     """Each frame matches at most one band of the re-measure's map (whole rows, the full
     search range), beside the marker's window and the lane ahead."""
-    monkeypatch.setattr(perception, "STRIP_WORK", 1_000_000)  # four bands at 320x240 / 48
-    with simulation(Setup((320, 240), 0.8)) as sim:
+    with simulation(Setup(start_z_m=0.8, **CAMERA)) as sim:
         strips = sim.servo.strips
         assert strips is not None and strips.strips == 4
         remeasures = bands = 0
@@ -89,18 +92,18 @@ def test_no_frame_of_the_robot_phase_matches_more_than_one_band(monkeypatch) -> 
     assert remeasures >= 2 and bands >= 8
 
 
-def test_moved_target_is_followed_when_its_map_takes_several_frames(monkeypatch) -> None:
-    monkeypatch.setattr(perception, "STRIP_WORK", 1_000_000)
+def test_moved_target_is_followed_when_its_map_takes_several_frames() -> None:
     faults = WorldFaults(events=(Event(1.5, "move", 0, z_m=1.0),))
-    with simulation(Setup((320, 240), 0.6, faults=faults)) as sim:
+    with simulation(Setup(start_z_m=0.6, faults=faults, **CAMERA)) as sim:
+        assert sim.servo.strips is not None and sim.servo.strips.strips == 4
         sim.run(4.5, settle=None)
         assert sim.servo.target_m == pytest.approx(1.0, abs=0.015)
 
 
-def test_vanished_target_stops_the_run_when_its_map_takes_several_frames(monkeypatch) -> None:
-    monkeypatch.setattr(perception, "STRIP_WORK", 1_000_000)
+def test_vanished_target_stops_the_run_when_its_map_takes_several_frames() -> None:
     faults = WorldFaults(events=(Event(1.0, "vanish", 0),))
-    with simulation(Setup((320, 240), 0.8, faults=faults, boxes=ALONE)) as sim:
+    with simulation(Setup(start_z_m=0.8, faults=faults, boxes=ALONE, **CAMERA)) as sim:
+        assert sim.servo.strips is not None and sim.servo.strips.strips == 4
         sim.run(9.0)  # two re-measures to find it gone, three to find no next object
         assert sim.servo.stop_reason == "target vanished"
 

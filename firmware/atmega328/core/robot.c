@@ -6,7 +6,7 @@
 #include "board.h"
 #include "drive.h"
 #include "frame.h"
-#include "link.h"
+#include "link_loss.h"
 
 /* A resend is recognised by SEQ, ID and the whole payload; commands are at most this long. */
 #define LAST_PAYLOAD_MAX 4
@@ -16,7 +16,7 @@ _Static_assert(PROTO_SET_DRIVE_LEN <= LAST_PAYLOAD_MAX && PROTO_SET_CONFIG_LEN <
 
 /* Shared with the timer interrupt (robot_guard): touched in the main loop only under
  * board_lock. */
-static struct link link;
+static struct link_loss link_loss;
 
 static struct {
     struct frame_parser parser;
@@ -64,9 +64,9 @@ static void send_nack(uint8_t seq, uint8_t error)
 static void output(void)
 {
     /* under the lock the guard cannot cut between the check and the write; once it has cut,
-     * only a new accepted SET_DRIVE (link_heard) lets the bridge be driven again */
+     * only a new accepted SET_DRIVE (link_loss_heard) lets the bridge be driven again */
     uint8_t state = board_lock();
-    uint8_t on = link.armed;
+    uint8_t on = link_loss.armed;
     board_motor_output(on ? robot.drive.applied[DRIVE_LEFT] : 0,
                        on ? robot.drive.applied[DRIVE_RIGHT] : 0);
     board_unlock(state);
@@ -98,7 +98,7 @@ static uint16_t advance(void)
 static void stop(void)
 {
     uint8_t state = board_lock();
-    link.armed = 0;
+    link_loss.armed = 0;
     board_unlock(state);
     advance();
     drive_stop(&robot.drive);
@@ -110,7 +110,7 @@ static void on_hello(const uint8_t *payload)
     struct proto_hello in;
     proto_hello_unpack(payload, &in);
     struct proto_hello_reply m = {in.nonce, PROTO_SCHEMA_HASH, FW_VERSION, robot.reset_cause,
-                                  link.timeout_ms};
+                                  link_loss.timeout_ms};
     uint8_t p[PROTO_HELLO_REPLY_LEN];
     proto_hello_reply_pack(p, &m);
     send(PROTO_MSG_HELLO_REPLY, p, sizeof p);
@@ -141,7 +141,7 @@ static void on_set_drive(const struct frame *f)
      * command too: a resend of it is applied again, which changes nothing but the ACK) */
     uint8_t state = board_lock();
     catch_up_guard();
-    link_heard(&link, robot.now_ms);
+    link_loss_heard(&link_loss, robot.now_ms);
     board_unlock(state);
     drive_command(&robot.drive, m.left, m.right);
     drive_tick(&robot.drive, advance());
@@ -154,7 +154,7 @@ static void on_set_config(const struct frame *f)
     struct proto_set_config m;
     proto_set_config_unpack(f->payload, &m);
     uint8_t state = board_lock();
-    link.timeout_ms = m.link_timeout_ms;
+    link_loss.timeout_ms = m.link_timeout_ms;
     board_unlock(state);
     robot.drive.accel_limit = m.accel_limit;
     send_ack(f->seq, PROTO_ACK_RESULT_APPLIED);
@@ -162,9 +162,9 @@ static void on_set_config(const struct frame *f)
 
 static uint8_t status_flags(void)
 {
-    return (link.lost ? PROTO_STATUS_LINK_LOST : 0) |
+    return (link_loss.lost ? PROTO_STATUS_LINK_LOST : 0) |
            (robot.reset_cause == PROTO_RESET_CAUSE_WATCHDOG ? PROTO_STATUS_WATCHDOG_RESET : 0) |
-           (link.armed ? PROTO_STATUS_DRIVING : 0) |
+           (link_loss.armed ? PROTO_STATUS_DRIVING : 0) |
            (drive_ramping(&robot.drive) ? PROTO_STATUS_ACCEL_LIMITED : 0);
 }
 
@@ -173,7 +173,7 @@ static void on_get_status(void)
     struct proto_status m = {
         robot.now_ms, robot.drive.applied[DRIVE_LEFT], robot.drive.applied[DRIVE_RIGHT],
         status_flags(), robot.reset_cause, robot.parser.good_frames, robot.parser.crc_errors,
-        robot.parser.framing_errors, link.timeout_ms, robot.drive.accel_limit,
+        robot.parser.framing_errors, link_loss.timeout_ms, robot.drive.accel_limit,
         board_rx_overruns(), board_tx_dropped(), robot.link_losses};
     uint8_t p[PROTO_STATUS_LEN];
     proto_status_pack(p, &m);
@@ -231,9 +231,9 @@ static uint8_t on_resend(const struct frame *f)
 {
     if (f->id == PROTO_MSG_SET_DRIVE) {
         uint8_t state = board_lock();
-        uint8_t armed = link.armed;
+        uint8_t armed = link_loss.armed;
         if (armed)
-            link_heard(&link, robot.now_ms);
+            link_loss_heard(&link_loss, robot.now_ms);
         board_unlock(state);
         if (!armed)
             return 0;
@@ -247,12 +247,12 @@ static uint8_t on_resend(const struct frame *f)
 static uint8_t catch_up_guard(void)
 {
     uint8_t state = board_lock();
-    uint8_t tripped = link.tripped;
-    link.tripped = 0;
+    uint8_t tripped = link_loss.tripped;
+    link_loss.tripped = 0;
     board_unlock(state);
     if (!tripped)
         return 0;
-    link.lost = 1;
+    link_loss.lost = 1;
     robot.link_losses++;
     robot.have_last = 0; /* a resend after this stop is applied again, not a duplicate */
     stop();
@@ -285,7 +285,7 @@ void robot_init(uint8_t reset_cause, uint32_t now_ms)
     frame_parser_init(&robot.parser);
     drive_init(&robot.drive);
     uint8_t state = board_lock();
-    link_init(&link, now_ms, PROTO_DEFAULT_LINK_TIMEOUT_MS);
+    link_loss_init(&link_loss, now_ms, PROTO_DEFAULT_LINK_TIMEOUT_MS);
     board_unlock(state);
     robot.drive.accel_limit = PROTO_DEFAULT_ACCEL_LIMIT;
     robot.now_ms = robot.last_tick_ms = now_ms;
@@ -328,10 +328,10 @@ void robot_tick(uint32_t now_ms)
 
 void robot_guard(uint32_t now_ms)
 {
-    /* the timer interrupt: the main loop only touches link under board_lock */
-    if (!link_expired(&link, now_ms))
+    /* the timer interrupt: the main loop only touches link_loss under board_lock */
+    if (!link_loss_expired(&link_loss, now_ms))
         return;
-    link.armed = 0;
-    link.tripped = 1;
+    link_loss.armed = 0;
+    link_loss.tripped = 1;
     board_motor_output(0, 0);
 }

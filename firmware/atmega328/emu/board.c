@@ -1,6 +1,7 @@
 /* The board API on a PC, for the emulator (host/emulator/core.py): motor outputs are kept in
- * variables and transmitted bytes in a buffer, both read back through the emu_ functions. The
- * firmware core (the core folder) and the frame parser are linked in unchanged. */
+ * variables and transmitted bytes in a buffer, both read back through the emu_ functions; the lock
+ * and the receive counter are single_thread.c's. The firmware core (the core folder) and the
+ * frame parser are linked in unchanged. */
 #include <stdint.h>
 #include <string.h>
 
@@ -29,23 +30,6 @@ void board_tx(const uint8_t *data, uint8_t n)
     }
     memcpy(tx + tx_len, data, n);
     tx_len += n;
-}
-
-/* The emulator calls robot_guard and the main-loop functions from one thread: nothing to hold. */
-uint8_t board_lock(void)
-{
-    return 0;
-}
-
-void board_unlock(uint8_t state)
-{
-    (void)state;
-}
-
-/* Bytes reach the core straight from the emulated line: none is lost to an overrun. */
-uint16_t board_rx_overruns(void)
-{
-    return 0;
 }
 
 uint16_t board_tx_dropped(void)
