@@ -11,20 +11,13 @@ import numpy as np
 import pytest
 
 from host.api import load_params_file
-from host.cli import build_parser, main
+from host.cli import build_parser
 from host.errors import HostError
 from host.params_file import save_params
 from host.stereo import MatcherParams
 from host.stereo.synthetic import synthetic_scene
 from host.tuning import make_space
-
-
-def _run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str]:
-    try:
-        code = main(argv)
-    except SystemExit as e:  # argparse's refusal
-        code = int(e.code or 0)
-    return code, capsys.readouterr().err
+from tests.in_process import host
 
 
 @pytest.fixture()
@@ -36,17 +29,16 @@ def pair(tmp_path: Path) -> list[str]:
 
 
 def test_the_old_spellings_give_the_same_map_with_one_note_each(
-        tmp_path: Path, pair: list[str], capsys: pytest.CaptureFixture[str]) -> None:
+        tmp_path: Path, pair: list[str]) -> None:
     maps = {}
     for how, flags in (("new", ["--block-size", "7", "--num-disparities", "16",
                                 "--min-disparity", "2"]),
                        ("old", ["--window", "7", "--num-disp", "16", "--min-disp", "2"])):
         npy = tmp_path / f"{how}.npy"
-        code, err = _run(pair + ["-o", str(tmp_path / f"{how}.png"), "--npy", str(npy), *flags],
-                         capsys)
-        assert code == 0, err
+        r = host(*pair, "-o", str(tmp_path / f"{how}.png"), "--npy", str(npy), *flags)
+        assert r.returncode == 0, r.stderr
         maps[how] = np.load(npy)
-        notes = [line for line in err.splitlines() if line.startswith("note:")]
+        notes = [line for line in r.stderr.splitlines() if line.startswith("note:")]
         if how == "new":
             assert notes == []
         else:
@@ -56,11 +48,9 @@ def test_the_old_spellings_give_the_same_map_with_one_note_each(
     np.testing.assert_array_equal(maps["old"], maps["new"])
 
 
-def test_the_old_spellings_are_not_in_the_help(capsys: pytest.CaptureFixture[str]) -> None:
+def test_the_old_spellings_are_not_in_the_help() -> None:
     for command in ("eval", "disparity", "tune", "servo"):
-        with pytest.raises(SystemExit):
-            main([command, "--help"])
-        text = capsys.readouterr().out
+        text = host(command, "--help").stdout
         assert "--block-size" in text and "--num-disparities" in text
         assert "--window " not in text and "--num-disp " not in text and "--windows" not in text
 
@@ -97,11 +87,11 @@ def test_an_old_params_file_is_read_with_its_space_renamed(
                                       ("num-disp", "num_disparities"),
                                       ("min_disp", "min_disparity")])
 def test_a_matcher_key_spelt_the_command_line_way_is_refused_naming_the_key(
-        tmp_path: Path, pair: list[str], key: str, new: str,
-        capsys: pytest.CaptureFixture[str]) -> None:
+        tmp_path: Path, pair: list[str], key: str, new: str) -> None:
     path = tmp_path / "p.toml"
     path.write_text(f'[matcher]\nmatcher = "sad"\n"{key}" = 7\n')
     out = tmp_path / "o.png"
-    code, err = _run(pair + ["-o", str(out), "--params", str(path)], capsys)
-    assert code == 2 and not out.exists()
-    assert err == f"host disparity: error: {path}: [matcher] key {key} is {new} in a params file\n"
+    r = host(*pair, "-o", str(out), "--params", str(path))
+    assert r.returncode == 2 and not out.exists()
+    assert r.stderr == (f"host disparity: error: {path}: [matcher] key {key} is {new} in a "
+                        f"params file\n")
