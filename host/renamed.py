@@ -7,3 +7,4 @@ from __future__ import annotations
 # --window, --num-disp, --min-disp: the MatcherParams field (params files' key, --block-size ...)
 PARAMETERS = {"window": "block_size", "num_disp": "num_disparities", "min_disp": "min_disparity"}
 SPACES = {"window": "block-size"}  # host tune --space, params files' [tuning] space
+TUNE_OPTIONS = {"windows": "block_sizes"}  # host tune --windows: the block-size space's sizes

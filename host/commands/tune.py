@@ -23,6 +23,7 @@ from host.commands.options import (
     add_matcher_options,
     add_old_spelling,
     int_range,
+    option,
     params_from_args,
 )
 from host.commands.swap_check import check_pairs
@@ -70,9 +71,10 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p.add_argument("--ray", nargs="?", const="local", metavar="ADDRESS",
                    help="evaluate on Ray: a local cluster, or the one at ADDRESS (host:port, "
                         "ray://host:port or auto); optional extra stereo-servo[ray]")
-    add_old_spelling(p, "--windows", p.add_argument(
-        "--block-sizes", default="5:41", metavar="LO:HI",
-        help="odd block sizes lo:hi (block-size space)"))
+    sizes = p.add_argument("--block-sizes", default="5:41", metavar="LO:HI",
+                           help="odd block sizes lo:hi (block-size space)")
+    for old, new in renamed.TUNE_OPTIONS.items():
+        add_old_spelling(p, option(old), {sizes.dest: sizes}[new])
     p.add_argument("--step", type=COUNT, default=1, help="action step in values of a parameter")
     p.add_argument("--alpha", type=FRACTION, help="qlearning: learning rate (default 0.5)")
     p.add_argument("--gamma", type=FRACTION,
