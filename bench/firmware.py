@@ -15,11 +15,11 @@ from pathlib import Path
 from host.emulator import build
 from host.emulator.pins import timeline
 from host.emulator.simavr import CYCLES_PER_BYTE, F_CPU, FLOODS, Script, flood, run
+from host.emulator.simavr import CYCLES_PER_MS as MS
 from host.link import protocol_gen as gen
 from host.link.frame import encode_frame
 from host.link.messages import pack, unpack
 
-MS = F_CPU // 1000
 NO_RAMP = gen.SetConfig(link_timeout_ms=gen.DEFAULT_LINK_TIMEOUT_MS, accel_limit=0)
 FRAME = len(encode_frame(0, *pack(NO_RAMP)))  # bytes of a SET_CONFIG or SET_DRIVE frame
 

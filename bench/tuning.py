@@ -303,9 +303,9 @@ def self_supervised(space: Space, names: list[str], scenes, gt_table: np.ndarray
 
 def ray_timing(scenes, ranges, workers: int) -> None:
     """Wall time of one grid evaluated locally, in processes and on a local Ray cluster."""
-    space = make_space("window", BASE)
+    space = make_space("block-size", BASE)
     score = GroundTruthScore(scenes, ranges)
-    print(f"\n== Ray against local: grid of the window space ({space.size} states) on "
+    print(f"\n== Ray against local: grid of the block-size space ({space.size} states) on "
           f"{', '.join(s.name for s in scenes)}; {conditions()}")
     results = {}
     for label, kw in (("local (1 process)", {}), (f"processes ({workers})", {"workers": workers}),
@@ -359,7 +359,7 @@ def main() -> int:
           f"{conditions()}")
     defaults = dict(zip(names, GroundTruthScore(scenes, ranges)(DEFAULTS)))
     tables = {}
-    for name in ("window", "sad"):
+    for name in ("block-size", "sad"):
         space = make_space(name, BASE)
         t0 = time.perf_counter()
         tables[name] = cached_table("grid", GroundTruthScore(scenes, ranges), space, scenes,
@@ -369,7 +369,7 @@ def main() -> int:
     only = args.only.split(",")
     status = 0
     if "compare" in only:
-        for name in ("window", "sad"):
+        for name in ("block-size", "sad"):
             compare(make_space(name, BASE), names, tables[name])
     if "loo" in only:
         leave_one_out(make_space("sad", BASE), names, tables["sad"], defaults)

@@ -19,8 +19,9 @@ COMMANDS = [eval_cmd, disparity, tune, cameras, capture, calibrate, servo, emula
 # one or two examples per command (a command module may define EXAMPLES itself instead)
 EXAMPLES = {
     "eval": ["host eval                               # the embedded Motorcycle pair",
-             "host eval ../shared/data/middlebury --matcher ncc --window 7 --picture out/"],
-    "disparity": ["host disparity left.png right.png -o disp.png --num-disp 64 --npy disp.npy"],
+             "host eval ../shared/data/middlebury --matcher ncc --block-size 7 --picture out/"],
+    "disparity": ["host disparity left.png right.png -o disp.png --num-disparities 64 "
+                  "--npy disp.npy"],
     "tune": ["host tune --out tuned.toml --plot tuning.png",
              "host tune ../shared/data/middlebury --space sad --method qlearning --workers 2"],
     "cameras": ["host cameras           # the stereo cameras plugged in, with their --camera",

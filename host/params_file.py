@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import math
 import os
+import sys
 import tomllib
 from pathlib import Path
 from typing import Any
 
 from host.errors import HostError
 from host.files import write_text_atomic
+from host.renamed import PARAMETERS, SPACES
 from host.stereo.params import MatcherParams
 
 
@@ -71,6 +73,16 @@ def load_params(path: str | os.PathLike[str]) -> tuple[MatcherParams, dict[str, 
         raise HostError(f"{p}: [matcher] must be a table")
     if "matcher" not in data:
         raise HostError(f"{p}: no [matcher] table")
+    for key in data["matcher"]:
+        if key.replace("-", "_") in PARAMETERS:  # never a key of a written file: the CLI's
+            raise HostError(f"{p}: [matcher] key {key} is {PARAMETERS[key.replace('-', '_')]} "
+                            f"in a params file")
+    tuning = data.get("tuning", {})
+    if isinstance(tuning, dict) and tuning.get("space") in SPACES:
+        new = SPACES[tuning["space"]]
+        print(f"note: {p}: [tuning] space {tuning['space']!r} is now {new!r} (read as such)",
+              file=sys.stderr)
+        tuning = tuning | {"space": new}
     for key, value in data["matcher"].items():
         if isinstance(value, float) and not math.isfinite(value):
             raise HostError(f"{p}: matcher parameter {key} must be a finite number, got {value}")
@@ -80,7 +92,7 @@ def load_params(path: str | os.PathLike[str]) -> tuple[MatcherParams, dict[str, 
         raise HostError(f"{p}: {e}") from None
     except TypeError as e:
         raise HostError(f"{p}: bad [matcher] table ({e})") from None
-    return params, data.get("tuning", {})
+    return params, tuning
 
 
 def load_disparity_range(path: str | os.PathLike[str]) -> dict[str, Any] | None:

@@ -147,7 +147,7 @@ def _run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str]
     return code, capsys.readouterr().err
 
 
-DISP = ["disparity", "{l}", "{r}", "--num-disp", "32"]
+DISP = ["disparity", "{l}", "{r}", "--num-disparities", "32"]
 SERVO = ["servo", "--camera", "replay:{replay}", "--port", "emulator"]
 
 # (argv with {name} for an input and {tmp}/{ro} for folders, words the one line must contain)
@@ -212,9 +212,9 @@ ROWS = [
     (["calibrate", "{replay}", "--square", "0"], "argument --square: must be > 0"),
     (["emulate", "--drop", "1"], "argument --drop: must be >= 0 and < 1"),
     # windows and ranges of the matcher
-    (DISP + ["-o", "{tmp}/o.png", "--window", "8"], "window must be odd"),
-    (DISP + ["-o", "{tmp}/o.png", "--window", "0"], "argument --window: must be >= 1"),
-    (DISP + ["-o", "{tmp}/o.png", "--num-disp", "900"], "wider than the image"),
+    (DISP + ["-o", "{tmp}/o.png", "--block-size", "8"], "window must be odd"),
+    (DISP + ["-o", "{tmp}/o.png", "--block-size", "0"], "argument --block-size: must be >= 1"),
+    (DISP + ["-o", "{tmp}/o.png", "--num-disparities", "900"], "wider than the image"),
     (DISP + ["-o", "{tmp}/o.png", "--uniqueness", "101"], "argument --uniqueness"),
     # ports
     (["servo", "--camera", "replay:{replay}", "--port", "{tmp}/no-such-port"],
@@ -292,7 +292,7 @@ def test_a_picture_named_from_data_stays_inside_the_folder(
     out = tmp_path / "deep" / "out"
     out.mkdir(parents=True)
     before = _tree(tmp_path)
-    assert main(["eval", str(scene), "--picture", str(out), "--num-disp", "16"]) == 0
+    assert main(["eval", str(scene), "--picture", str(out), "--num-disparities", "16"]) == 0
     new = set(_tree(tmp_path)) - set(before)
     assert new == {f"deep/out/{file}"}
     assert not Path("/tmp/abs/x.png").exists()
@@ -301,7 +301,7 @@ def test_a_picture_named_from_data_stays_inside_the_folder(
 def test_picture_and_ros_folders_are_made_as_capture_makes_its_own(tmp_path: Path) -> None:
     scene = _scene(tmp_path / "scene", {"scale": 4, "scene": "s"})
     out = tmp_path / "new" / "pictures"
-    assert main(["eval", str(scene), "--picture", str(out), "--num-disp", "16"]) == 0
+    assert main(["eval", str(scene), "--picture", str(out), "--num-disparities", "16"]) == 0
     assert [p.name for p in out.iterdir()] == ["s.png"]
 
 

@@ -63,7 +63,7 @@ def test_a_replay_without_the_marker_exits_3_with_the_reason(tmp_path: Path, cap
     with warnings.catch_warnings(record=True) as caught:  # e.g. numpy's "All-NaN slice"
         warnings.simplefilter("always")
         assert main(["servo", "--camera", f"replay:{tmp_path}", "--port", "emulator",
-                     "--num-disp", "48", "--log", str(log)]) == NOT_REACHED
+                     "--num-disparities", "48", "--log", str(log)]) == NOT_REACHED
     assert [str(w.message) for w in caught if w.category is RuntimeWarning] == []
     err = capsys.readouterr().err
     assert err.splitlines()[-1] == ("host servo: not reached: the marker was never seen in 3 "

@@ -26,8 +26,8 @@ def test_a_signal_stops_the_robot_and_keeps_the_log(tmp_path: Path, signum: int)
     record, log, plot = tmp_path / "received.bin", tmp_path / "run.csv", tmp_path / "run.png"
     env = os.environ | {"HOST_EMULATOR_RECORD": str(record)}
     proc = subprocess.Popen(
-        [sys.executable, "-m", "host", "servo", "--sim", "--border", "clip", "--num-disp", "48",
-         "--settle", "0", "--duration", "120", "--log", str(log),
+        [sys.executable, "-m", "host", "servo", "--sim", "--border", "clip",
+         "--num-disparities", "48", "--settle", "0", "--duration", "120", "--log", str(log),
          "--plot", str(plot)],
         stderr=subprocess.PIPE, text=True, env=env, cwd=tmp_path)
     try:
@@ -89,8 +89,8 @@ def _run_with_a_ctrl_c_in_the_plot(tmp_path: Path, monkeypatch, during_run: bool
     monkeypatch.setattr(servo_cmd, "plot_run", plot)
     if during_run:
         monkeypatch.setattr(servo_cmd, "run_servo", run)
-    return main(["servo", "--sim", "--border", "clip", "--num-disp", "48", "--duration", "0.5",
-                 "--settle", "0", "--log", str(tmp_path / "run.csv"),
+    return main(["servo", "--sim", "--border", "clip", "--num-disparities", "48",
+                 "--duration", "0.5", "--settle", "0", "--log", str(tmp_path / "run.csv"),
                  "--plot", str(tmp_path / "run.png")])
 
 

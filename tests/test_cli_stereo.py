@@ -33,7 +33,7 @@ def pair(tmp_path: Path) -> tuple[Path, Path]:
 def test_disparity_writes_picture_and_raw_map(pair: tuple[Path, Path], tmp_path: Path) -> None:
     out, npy = tmp_path / "d.png", tmp_path / "d.npy"
     assert main(["disparity", str(pair[0]), str(pair[1]), "-o", str(out), "--npy", str(npy),
-                 "--num-disp", "32", "--window", "7"]) == 0
+                 "--num-disparities", "32", "--block-size", "7"]) == 0
     pic = cv2.imread(str(out))
     raw = np.load(npy)
     assert raw.shape == (120, 160) and raw.dtype == np.float32
@@ -53,7 +53,7 @@ def test_eval_json_has_the_documented_keys(middlebury: Path, capsys) -> None:
 def test_eval_scores_middlebury_regions_by_their_masks(middlebury: Path, capsys) -> None:
     # Venus has all.png: its "all" region is not every pixel with known ground truth
     scene = load_scene(middlebury / "venus")
-    argv = ["eval", str(middlebury / "venus"), "--json", "--matcher", "sad", "--window", "7",
+    argv = ["eval", str(middlebury / "venus"), "--json", "--matcher", "sad", "--block-size", "7",
             "--border", "clip"]
     assert main(argv) == 0
     row = json.loads(capsys.readouterr().out)["scenes"][0]
@@ -77,7 +77,7 @@ def test_eval_default_scene_prints_a_table_with_null_nonocc(capsys) -> None:
     assert main(["eval", "--json"]) == 0
     row = json.loads(capsys.readouterr().out)["scenes"][0]
     assert row["scene"] == "motorcycle" and row["bad_nonocc"] is None and row["bad_disc"] is None
-    assert main(["eval", "--window", "11"]) == 0
+    assert main(["eval", "--block-size", "11"]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert lines[1].split() == ["scene", "bad%", "nonocc%", "disc%", "rms", "density%", "ms"]
     assert lines[2].split()[0] == "motorcycle" and lines[2].split()[2:4] == ["-", "-"]
@@ -86,10 +86,10 @@ def test_eval_default_scene_prints_a_table_with_null_nonocc(capsys) -> None:
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["--window", "8"], "window must be odd"),
-    (["--window", "301"], "out of range"),
-    (["--num-disp", "900"], "wider than the image"),
-    (["--matcher", "opencv-bm", "--num-disp", "40"], "divisible by 16"),
+    (["--block-size", "8"], "window must be odd"),
+    (["--block-size", "301"], "out of range"),
+    (["--num-disparities", "900"], "wider than the image"),
+    (["--matcher", "opencv-bm", "--num-disparities", "40"], "divisible by 16"),
 ])
 def test_bad_matcher_options_are_one_line_errors(pair: tuple[Path, Path], tmp_path: Path,
                                                  argv: list[str], message: str) -> None:
@@ -157,7 +157,7 @@ def test_params_file_without_a_range_keeps_the_scenes_range_policy(middlebury: P
     path.write_text('[matcher]\nmatcher = "sad"\nblock_size = 7\nborder = "clip"\n')
     assert main(["eval", cones, "--json", "--params", str(path)]) == 0
     from_file = json.loads(capsys.readouterr().out)["scenes"][0]["bad"]
-    assert main(["eval", cones, "--json", "--window", "7", "--border", "clip"]) == 0
+    assert main(["eval", cones, "--json", "--block-size", "7", "--border", "clip"]) == 0
     scene_policy = json.loads(capsys.readouterr().out)["scenes"][0]["bad"]
     assert from_file == scene_policy
     # a file that fixes the range keeps it: 16 disparities are far too few for Cones

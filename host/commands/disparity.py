@@ -60,5 +60,5 @@ def run(args: argparse.Namespace) -> int:
             write_npy_atomic(args.npy, disp)
     density = 100.0 * float((disp == disp).mean())
     print(f"{args.out}: {disp.shape[1]}x{disp.shape[0]}, density {density:.1f}%, "
-          f"{ms:.1f} ms ({params.matcher}, window {params.block_size})", file=sys.stderr)
+          f"{ms:.1f} ms ({params.matcher}, block size {params.block_size})", file=sys.stderr)
     return 0

@@ -16,7 +16,7 @@ import numpy as np
 from host.commands.options import (
     POSITIVE,
     add_matcher_options,
-    num_disp_given,
+    num_disparities_given,
     params_from_args,
 )
 from host.errors import HostError
@@ -116,7 +116,7 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps({"matcher": params.to_dict(), "scenes": out}))
         return 0
-    print(f"matcher {params.matcher}, window {params.block_size}, rho {args.rho} px")
+    print(f"matcher {params.matcher}, block size {params.block_size}, rho {args.rho} px")
     print(f"{'scene':<16}{'bad%':>8}{'nonocc%':>9}{'disc%':>8}{'rms':>8}{'density%':>10}"
           f"{'ms':>9}")
     for r in out:
@@ -134,7 +134,7 @@ def run(args: argparse.Namespace) -> int:
 
 def _score(scene: Scene, params: MatcherParams, args: argparse.Namespace) -> dict[str, Any]:
     """Score one scene; with --picture, stage its picture (named from the scene, made safe)."""
-    p = params if num_disp_given(args) else _scene_range(args, params, scene)
+    p = params if num_disparities_given(args) else _scene_range(args, params, scene)
     row = score_scene(scene, p, args.rho, args.round8)
     if args.picture:
         path = check_output(inside(args.picture, safe_name(scene.name, ".png")), IMAGE,

@@ -6,8 +6,11 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 from collections.abc import Callable
+from typing import Any
 
+from host import renamed
 from host.params_file import load_disparity_range, load_matcher_table, load_params
 from host.stereo.params import BORDERS, MATCHERS, SGM_PATHS, MatcherParams
 
@@ -72,17 +75,50 @@ def _tolerance_or_off(text: str) -> float:
 _tolerance_or_off.__name__ = "float"
 
 
+def option(name: str) -> str:
+    """The command-line spelling of a MatcherParams field or params-file key: --block-size."""
+    return "--" + name.replace("_", "-")
+
+
+class _OldSpelling(argparse.Action):
+    """An option's former spelling, kept so that old scripts run: stored as the new option
+    (whose dest it shares), with a one-line note on stderr naming the new spelling."""
+
+    def __init__(self, option_strings: list[str], dest: str, new: str, **kw: Any) -> None:
+        super().__init__(option_strings, dest, help=argparse.SUPPRESS,
+                         default=argparse.SUPPRESS, **kw)
+        self.new = new
+
+    def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace,
+                 values: Any, option_string: str | None = None) -> None:
+        print(f"note: {option_string} is now {self.new} (the old spelling will go)",
+              file=sys.stderr)
+        setattr(namespace, self.dest, values)
+
+
+def add_old_spelling(g: argparse._ActionsContainer, old: str, new: argparse.Action) -> None:
+    """old (e.g. --window) read as the option new (--block-size), with a note (_OldSpelling)."""
+    g.add_argument(old, dest=new.dest, type=new.type or str, action=_OldSpelling,
+                   new=new.option_strings[0])
+
+
 def add_matcher_options(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("matcher (defaults: --params file, else the built-in defaults)")
     g.add_argument("--params", metavar="FILE", help="tuned parameters file (host tune --out)")
     g.add_argument("--matcher", choices=MATCHERS,
                    help="matching cost, or an OpenCV matcher; each starts from its measured "
-                        "best settings (sgm: window 1, clip, LR 0, uniqueness 30, fill, 4 paths, "
-                        "median 5, whole pixels)")
-    g.add_argument("--window", type=int_range(1), metavar="N", help="block size, odd (px)")
-    g.add_argument("--num-disp", type=COUNT, metavar="N",
-                   help="number of disparities (default: from the scene's ground truth, else 64)")
-    g.add_argument("--min-disp", type=int, metavar="N", help="smallest disparity (px)")
+                        "best settings (sgm: block size 1, clip, LR 0, uniqueness 30, fill, "
+                        "4 paths, median 5, whole pixels)")
+    new = {a.dest: a for a in (
+        g.add_argument(option("block_size"), type=int_range(1), metavar="N",
+                       help="side of the matching window, odd (px)"),
+        g.add_argument(option("num_disparities"), type=COUNT, metavar="N",
+                       help="number of disparities (default: from the scene's ground truth, "
+                            "else 64)"),
+        g.add_argument(option("min_disparity"), type=int, metavar="N",
+                       help="smallest disparity (px)"))}
+    for old, field in renamed.PARAMETERS.items():
+        add_old_spelling(g, option(old), new[field])
     g.add_argument("--lr-check", type=_tolerance_or_off, metavar="PX",
                    help="left-right consistency tolerance (px), or off (the matcher's default "
                         "when not given)")
@@ -104,10 +140,11 @@ def add_matcher_options(p: argparse.ArgumentParser) -> None:
                    help="match on grey even when the images have colour")
 
 
-_FIELDS = {"matcher": "matcher", "window": "block_size", "num_disp": "num_disparities",
-           "min_disp": "min_disparity", "lr_check": "lr_check", "uniqueness": "uniqueness_ratio",
-           "border": "border", "fill": "fill", "median": "median", "subpixel": "subpixel",
-           "colour": "colour", "paths": "paths"}
+_FIELDS = {"matcher": "matcher", "block_size": "block_size",
+           "num_disparities": "num_disparities", "min_disparity": "min_disparity",
+           "lr_check": "lr_check", "uniqueness": "uniqueness_ratio", "border": "border",
+           "fill": "fill", "median": "median", "subpixel": "subpixel", "colour": "colour",
+           "paths": "paths"}
 
 
 def params_from_args(args: argparse.Namespace) -> MatcherParams:
@@ -123,11 +160,11 @@ def params_from_args(args: argparse.Namespace) -> MatcherParams:
     return base.replace(**changes).validate()
 
 
-def num_disp_given(args: argparse.Namespace) -> bool:
+def num_disparities_given(args: argparse.Namespace) -> bool:
     """Whether the disparity range came from the user: the option, or a params file whose
     [matcher] table fixes it (num_disparities) rather than storing a [disparity_range] policy.
     A params file with neither keeps the scene's own range policy."""
-    if args.num_disp is not None:
+    if args.num_disparities is not None:
         return True
     if args.params is None or load_disparity_range(args.params) is not None:
         return False

@@ -338,12 +338,12 @@ def _run_servo(args: argparse.Namespace, servo: Servo, geometry: Geometry,
                 if args.plot:
                     plot_run(args.plot, servo.rows, geometry)
     ended = end.how == ENDED
-    failed, msg = replay_outcome(servo, servo.source) if ended else outcome(servo)
+    exit_status, msg = replay_outcome(servo, servo.source) if ended else outcome(servo)
     if world is not None:
         msg += (f"; true robot depth {world.robot.z_m:.3f} m, nearest box "
                 f"{world.nearest_box().z_m:.3f} m")
-    if failed:
-        raise (RecordingEnded if failed == RecordingEnded.status else NotReached)(msg)
+    if exit_status != 0:  # NOT_REACHED or RECORDING_ENDED: the error that carries it
+        raise (RecordingEnded if exit_status == RecordingEnded.status else NotReached)(msg)
     print(msg, file=sys.stderr)
     if servo.requested_stop:
         robot = servo.link.status()

@@ -10,35 +10,27 @@ from typing import Any
 
 from host.camera.source import StereoFrame, StereoSource
 from host.camera.swapped import SwapVerdict, swap_verdict
+from host.camera.wrapper import WrappedSource
 from host.errors import HostError
 
 FRAMES = 3  # pairs looked at, at most, until one is conclusive
 
 
-class CheckedSource(StereoSource):
+class CheckedSource(WrappedSource):
     """inner with the pairs read for the check handed on first, then the rest; swap: each pair
     with its views exchanged (before the rectification inner would have applied)."""
 
     def __init__(self, inner: StereoSource) -> None:
-        self.inner = inner
+        super().__init__(inner)
         self.rectify, inner.rectify = inner.rectify, None
         self.held: list[StereoFrame] = []
         self.swap = False
-
-    def __getattr__(self, name: str) -> Any:  # the inner source's own (clock, ended, ...)
-        return getattr(self.inner, name)
 
     def _read(self) -> StereoFrame | None:
         frame = self.held.pop(0) if self.held else self.inner.read()
         if frame is None or not self.swap:
             return frame
         return StereoFrame(frame.right, frame.left, frame.t_right, frame.t_left)
-
-    def describe(self) -> dict[str, Any]:
-        return self.inner.describe()
-
-    def close(self) -> None:
-        self.inner.close()
 
 
 def look(source: CheckedSource, frames: int = FRAMES) -> SwapVerdict | None:

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from host import renamed
 from host.camera.open import add_camera_options, known_geometry, open_source, parse_size
 from host.commands.options import (
     COUNT,
@@ -20,7 +21,9 @@ from host.commands.options import (
     POSITIVE,
     SEED,
     add_matcher_options,
+    add_old_spelling,
     int_range,
+    option,
     params_from_args,
 )
 from host.commands.swap_check import check_pairs
@@ -53,8 +56,8 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
                         "roughness), no ground truth")
     p.add_argument("--frames", type=COUNT, default=4, metavar="N",
                    help="--camera: tune on N pairs spread over what the camera gives")
-    p.add_argument("--space", choices=SPACES, default="window",
-                   help="parameters to tune: the window alone, or a matcher's several")
+    p.add_argument("--space", type=_space, choices=SPACES, default="block-size",
+                   help="parameters to tune: the block size alone, or a matcher's several")
     p.add_argument("--method", choices=METHODS, default=DEFAULT_METHOD,
                    help="Optuna's TPE (the default: within 0.5 pt of the grid optimum in 10 of "
                         "10 seeds on each space measured, docs/tuning.md), the paper's eq. 6 "
@@ -68,7 +71,10 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p.add_argument("--ray", nargs="?", const="local", metavar="ADDRESS",
                    help="evaluate on Ray: a local cluster, or the one at ADDRESS (host:port, "
                         "ray://host:port or auto); optional extra stereo-servo[ray]")
-    p.add_argument("--windows", default="5:41", help="odd window sizes lo:hi (window space)")
+    sizes = p.add_argument("--block-sizes", default="5:41", metavar="LO:HI",
+                           help="odd block sizes lo:hi (block-size space)")
+    for old, new in renamed.TUNE_OPTIONS.items():
+        add_old_spelling(p, option(old), {sizes.dest: sizes}[new])
     p.add_argument("--step", type=COUNT, default=1, help="action step in values of a parameter")
     p.add_argument("--alpha", type=FRACTION, help="qlearning: learning rate (default 0.5)")
     p.add_argument("--gamma", type=FRACTION,
@@ -102,6 +108,15 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 
 
 TUNE_BORDER = "clip"  # bench/tuning.py and docs/tuning.md measured every figure with it
+
+
+def _space(name: str) -> str:
+    """--space's type: a space's former name read as its name, with a note on stderr."""
+    if name in renamed.SPACES:
+        print(f"note: --space {name} is now {renamed.SPACES[name]} (the old name will go)",
+              file=sys.stderr)
+        return renamed.SPACES[name]
+    return name
 
 
 def _progress(total: int, enabled: bool, what: str) -> Any:
@@ -138,9 +153,9 @@ def _check_args(args: argparse.Namespace) -> int:
                 or re.fullmatch(r"[\w.\-]+:\d+", args.ray)):
             raise HostError(f"--ray ADDRESS must be host:port, ray://host:port or auto, got "
                             f"{args.ray!r} (put scene folders before --ray)")
-    if args.num_disp is not None or args.min_disp is not None:
+    if args.num_disparities is not None or args.min_disparity is not None:
         raise HostError("tune derives each scene's disparity range: use --range "
-                        "(e.g. fixed:N) instead of --num-disp / --min-disp")
+                        "(e.g. fixed:N) instead of --num-disparities / --min-disparity")
     return iterations
 
 
@@ -241,7 +256,7 @@ class TuneJob:
             raise HostError("the self-supervised objective uses no ground truth: choose --range "
                             "coarse, depth:NEAR:FAR or fixed:N")
         ranges = _ranges(scenes, policy, focal_baseline)
-        space = make_space(args.space, params_from_args(args), odd_range(args.windows))
+        space = make_space(args.space, params_from_args(args), odd_range(args.block_sizes))
         if args.method in ("paper", "guided") and len(space.dims) != 1:
             raise HostError(f"the {args.method} learner tunes one parameter; space {space.name} "
                             f"has {len(space.dims)} (use --method qlearning)")

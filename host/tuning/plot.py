@@ -12,7 +12,7 @@ from host.files import write_bytes_atomic
 from host.tuning.learners import TuneResult
 
 STARTS = ("paper", "guided", "qlearning")  # learners that walk from a start state
-UNITS = {"block_size": "window (px)", "lr_fill": "LR check with fill (px)"}
+UNITS = {"block_size": "block size (px)", "lr_fill": "LR check with fill (px)"}
 
 
 def _value(v: object) -> str:

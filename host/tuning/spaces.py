@@ -7,6 +7,7 @@ import itertools
 from dataclasses import dataclass
 from typing import Any
 
+from host import renamed
 from host.errors import HostError
 from host.stereo.params import MatcherParams
 
@@ -78,35 +79,35 @@ class Space:
 
 
 def odd_range(spec: str) -> tuple[int, ...]:
-    """'5:41' -> 5, 7, ..., 41 (odd window sizes)."""
+    """'5:41' -> 5, 7, ..., 41 (odd block sizes)."""
     try:
         lo, hi = (int(x) for x in spec.split(":"))
     except ValueError:
-        raise HostError(f"window range must look like 5:41, got {spec!r}") from None
+        raise HostError(f"block-size range must look like 5:41, got {spec!r}") from None
     if lo < 1 or hi < lo or lo % 2 == 0 or hi % 2 == 0:
-        raise HostError(f"window range needs odd bounds lo <= hi, got {spec!r}")
+        raise HostError(f"block-size range needs odd bounds lo <= hi, got {spec!r}")
     return tuple(range(lo, hi + 1, 2))
 
 
-SPACES = ("window", "sad", "opencv-bm", "opencv-sgbm")
+SPACES = ("block-size", "sad", "opencv-bm", "opencv-sgbm")
 
 
-def make_space(name: str, base: MatcherParams, windows: tuple[int, ...] = odd_range("5:41")
+def make_space(name: str, base: MatcherParams, block_sizes: tuple[int, ...] = odd_range("5:41")
                ) -> Space:
     """The named space around base (which fixes every parameter the space does not vary).
 
     No space tunes the disparity range: it is the scene's (host.tuning.disparity_range)."""
-    if name == "window":
-        return Space(name, (Dimension("block_size", windows),), base)
+    if name == "block-size":
+        return Space(name, (Dimension("block_size", block_sizes),), base)
     if name == "sad":
         return Space(name, (
-            Dimension("block_size", tuple(w for w in windows if w <= 25)),
+            Dimension("block_size", tuple(w for w in block_sizes if w <= 25)),
             Dimension("lr_fill", (None, 2.0, 1.0, 0.5)),  # by strictness: off = no limit
             Dimension("matcher", ("sad", "ssd", "ncc"), cyclic=True),
         ), base)
     if name == "opencv-bm":
         return Space(name, (
-            Dimension("block_size", tuple(w for w in windows if w <= 31)),
+            Dimension("block_size", tuple(w for w in block_sizes if w <= 31)),
             Dimension("pre_filter_cap", (15, 31, 47, 63)),
             Dimension("texture_threshold", (0, 10, 20, 40)),
             Dimension("uniqueness_ratio", (0, 5, 10, 15, 20)),
@@ -120,4 +121,5 @@ def make_space(name: str, base: MatcherParams, windows: tuple[int, ...] = odd_ra
             Dimension("uniqueness_ratio", (0, 5, 10, 15)),
             Dimension("mode", ("sgbm", "hh", "sgbm3way"), cyclic=True),
         ), base.replace(matcher="opencv-sgbm"))
-    raise HostError(f"unknown space {name!r} (choose from {', '.join(SPACES)})")
+    now = f"now {renamed.SPACES[name]!r}; " if name in renamed.SPACES else ""
+    raise HostError(f"unknown space {name!r} ({now}choose from {', '.join(SPACES)})")

@@ -241,7 +241,7 @@ def test_the_flashed_firmware_holds_the_simulated_robot_at_the_target(flashed, t
     log = tmp_path / "run.csv"
     r = subprocess.run([str(ROOT / ".venv" / "bin" / "host"), "servo", "--sim", "--robot", "uno",
                         "--flash", str(tmp_path / "flash.bin"), "--start-depth", "0.9",
-                        "--border", "clip", "--num-disp", "48", "--log", str(log)],
+                        "--border", "clip", "--num-disparities", "48", "--log", str(log)],
                        capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr[-2000:]
     assert "held at " in r.stderr

@@ -68,7 +68,7 @@ def test_capture_records_every_pair(src: Path, tmp_path: Path) -> None:
 
 def test_view_records_the_maps_it_showed(src: Path, tmp_path: Path) -> None:
     rec = tmp_path / "view.mcap"
-    r = _host("view", "--camera", f"replay:{src}", "--border", "clip", "--num-disp", "48",
+    r = _host("view", "--camera", f"replay:{src}", "--border", "clip", "--num-disparities", "48",
               "--duration", "4", "--record", str(rec))
     assert r.returncode == 0, r.stderr
     topics = _read(rec)

@@ -103,7 +103,7 @@ def test_params_file_stores_the_policy_and_eval_applies_it(tmp_path: Path, capsy
     _write_scene(tmp_path / "near", 1, 30)
     _write_scene(tmp_path / "far", 2, 10)
     out = tmp_path / "p.toml"
-    assert main(["tune", str(tmp_path), "--method", "grid", "--windows", "5:9",
+    assert main(["tune", str(tmp_path), "--method", "grid", "--block-sizes", "5:9",
                  "--border", "clip", "--out", str(out), "--json"]) == 0
     result = json.loads(capsys.readouterr().out)
     (lo_far, n_far), (lo_near, n_near) = result["ranges"]["far"], result["ranges"]["near"]
@@ -120,7 +120,7 @@ def test_leave_one_out_scores_each_scene_with_parameters_tuned_on_the_others(
         tmp_path: Path, capsys) -> None:
     for i, d in enumerate((30, 20, 12)):
         _write_scene(tmp_path / f"s{i}", i, d)
-    assert main(["tune", str(tmp_path), "--method", "grid", "--windows", "5:9",
+    assert main(["tune", str(tmp_path), "--method", "grid", "--block-sizes", "5:9",
                  "--border", "clip", "--cv", "--json"]) == 0
     result = json.loads(capsys.readouterr().out)
     folds = result["leave_one_out"]
@@ -129,9 +129,9 @@ def test_leave_one_out_scores_each_scene_with_parameters_tuned_on_the_others(
         assert 0 <= fold["bad"] <= 100 and fold["params"]["block_size"] in (5, 7, 9)
     # s2 left out: the window tuned on s0 and s1 scores on s2 what eval says it does
     capsys.readouterr()
-    assert main(["eval", str(tmp_path / "s2"), "--border", "clip", "--window",
-                 str(folds["s2"]["params"]["block_size"]), "--num-disp",
-                 str(sum(result["ranges"]["s2"])), "--min-disp", str(result["ranges"]["s2"][0]),
-                 "--json"]) == 0
+    assert main(["eval", str(tmp_path / "s2"), "--border", "clip", "--block-size",
+                 str(folds["s2"]["params"]["block_size"]), "--num-disparities",
+                 str(sum(result["ranges"]["s2"])), "--min-disparity",
+                 str(result["ranges"]["s2"][0]), "--json"]) == 0
     row = json.loads(capsys.readouterr().out)["scenes"][0]
     assert row["bad"] == pytest.approx(folds["s2"]["bad"], abs=1e-6)

@@ -36,7 +36,7 @@ def test_q_learning_update_rule() -> None:
     assert q[(0,)][2] == pytest.approx(0.5 * (2.0 + 0.9 * 4.0))
 
 
-WINDOW = Space("window", (Dimension("block_size", tuple(range(5, 42, 2))),), MatcherParams())
+WINDOW = Space("block-size", (Dimension("block_size", tuple(range(5, 42, 2))),), MatcherParams())
 FOUR_D = Space("four", (Dimension("a", tuple(range(12))), Dimension("b", tuple(range(6))),
                         Dimension("c", ("x", "y", "z"), cyclic=True),
                         Dimension("d", tuple(range(5)))), MatcherParams())
@@ -126,7 +126,7 @@ def test_zero_iterations_and_unknown_method_are_errors() -> None:
 
 
 def test_spaces_map_states_to_valid_matcher_parameters() -> None:
-    for name in ("window", "sad", "opencv-bm", "opencv-sgbm"):
+    for name in ("block-size", "sad", "opencv-bm", "opencv-sgbm"):
         space = make_space(name, MatcherParams(num_disparities=64))
         for s in space.states()[:: max(1, space.size // 50)]:
             p = space.params(s).validate(width=450)

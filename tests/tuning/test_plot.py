@@ -9,7 +9,7 @@ from host.tuning.plot import _label, figure_title, series
 from host.tuning.spaces import make_space
 
 
-def _result(method: str, space_name: str = "window") -> TuneResult:
+def _result(method: str, space_name: str = "block-size") -> TuneResult:
     space = make_space(space_name, MatcherParams())
     start, a, b = space.states()[:3]
     # the start state is the best, and the learner never came back to it

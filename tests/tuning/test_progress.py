@@ -10,7 +10,7 @@ import subprocess
 import sys
 import termios
 
-ARGV = [sys.executable, "-m", "host", "tune", "--method", "grid", "--windows", "5:7"]
+ARGV = [sys.executable, "-m", "host", "tune", "--method", "grid", "--block-sizes", "5:7"]
 
 
 def test_the_bar_shows_on_a_terminal() -> None:
@@ -31,7 +31,7 @@ def test_the_bar_shows_on_a_terminal() -> None:
     os.close(master)
     assert proc.returncode == 0
     text = seen.decode(errors="replace")
-    assert "grid on window" in text and "0/2" in text and "2/2" in text, text
+    assert "grid on block-size" in text and "0/2" in text and "2/2" in text, text
     assert "2/2" not in out  # the bar is on stderr, the result on stdout
 
 
@@ -40,4 +40,4 @@ def test_no_bar_when_stderr_is_not_a_terminal(capsys) -> None:
 
     assert main(ARGV[3:]) == 0
     out, err = capsys.readouterr()
-    assert err == "" and out.startswith("grid on window")
+    assert err == "" and out.startswith("grid on block-size")

@@ -31,7 +31,7 @@ def test_ray_backend_matches_the_local_run(tmp_path: Path) -> None:
         cv2.imwrite(str(scene / "disp_left.png"), np.nan_to_num(s.gt * 4).astype(np.uint16))
         (scene / "meta.json").write_text(json.dumps({"scene": scene.name, "scale": 4}))
     argv = [sys.executable, "-m", "host", "tune", str(tmp_path), "--method", "qlearning",
-            "--iterations", "8", "--episodes", "2", "--seed", "3", "--windows", "5:11",
+            "--iterations", "8", "--episodes", "2", "--seed", "3", "--block-sizes", "5:11",
             "--border", "clip", "--json"]
     env = os.environ | {"RAY_USAGE_STATS_ENABLED": "0"}
     local = subprocess.run(argv, capture_output=True, text=True, env=env, timeout=300)

@@ -138,7 +138,7 @@ def test_tune_on_replayed_frames_without_ground_truth(tmp_path, scene) -> None:
         cv2.imwrite(str(frames / f"right_{i:03d}.png"), s.right)
     out = tmp_path / "tuned.toml"
     r = _tune("--camera", f"replay:{frames}", "--objective", "self", "--method", "grid",
-              "--windows", "5:9", "--border", "clip", "--frames", "2", "--out", str(out))
+              "--block-sizes", "5:9", "--border", "clip", "--frames", "2", "--out", str(out))
     assert r.returncode == 0, r.stderr
     assert "self-supervised score" in r.stdout
     params, tuning = load_params(out)
@@ -162,7 +162,7 @@ def test_tuning_on_a_camera_is_not_misled_by_unequal_sensor_gains(tmp_path) -> N
         cv2.imwrite(str(frames / "left_000.png"), s.left)
         cv2.imwrite(str(frames / "right_000.png"), right.astype(np.uint8))
         r = _tune("--camera", f"replay:{frames}", "--objective", "self", "--method", "grid",
-                  "--space", "sad", "--windows", "5:9", "--border", "clip", "--frames", "1",
+                  "--space", "sad", "--block-sizes", "5:9", "--border", "clip", "--frames", "1",
                   "--json")
         assert r.returncode == 0, r.stderr
         out = json.loads(r.stdout)
@@ -176,7 +176,7 @@ def test_tuning_on_a_camera_is_not_misled_by_unequal_sensor_gains(tmp_path) -> N
 def test_tune_on_the_simulated_camera_with_its_depth_range(tmp_path) -> None:
     out = tmp_path / "tuned.toml"
     r = _tune("--camera", "sim", "--objective", "self", "--method", "random", "--iterations",
-              "2", "--windows", "7:11", "--frames", "1", "--range", "depth:0.8:3.5",
+              "2", "--block-sizes", "7:11", "--frames", "1", "--range", "depth:0.8:3.5",
               "--out", str(out))
     assert r.returncode == 0, r.stderr
     assert 'policy = "depth:0.8:3.5"' in out.read_text()

@@ -35,7 +35,7 @@ def scene():
 
 
 def test_guided_window_tuning_ends_within_half_a_point_of_the_grid_best(scene) -> None:
-    space = make_space("window", MatcherParams(num_disparities=32), odd_range("3:27"))
+    space = make_space("block-size", MatcherParams(num_disparities=32), odd_range("3:27"))
     obj = gt_objective([scene], space)
     best_grid = tune("grid", obj, space, 0, 0).best_bad
     for seed in range(3):
@@ -45,7 +45,7 @@ def test_guided_window_tuning_ends_within_half_a_point_of_the_grid_best(scene) -
 
 def test_tune_writes_params_plot_and_json(tmp_path: Path, capsys) -> None:
     out, fig = tmp_path / "p.toml", tmp_path / "fig.png"
-    assert main(["tune", "--method", "paper", "--iterations", "6", "--windows", "7:15",
+    assert main(["tune", "--method", "paper", "--iterations", "6", "--block-sizes", "7:15",
                  "--out", str(out), "--plot", str(fig), "--json"]) == 0
     result = json.loads(capsys.readouterr().out)
     for key in ("method", "space", "best_params", "best_bad", "evaluations", "iterations",
@@ -66,18 +66,18 @@ def test_plain_tune_runs_in_the_measured_conditions(tmp_path: Path, capsys) -> N
     """The defaults are what docs/tuning.md measured: TPE, clipped borders, the
     ground-truth range from the nonocc percentiles."""
     out = tmp_path / "p.toml"
-    assert main(["tune", "--windows", "9:13", "--out", str(out), "--json"]) == 0
+    assert main(["tune", "--block-sizes", "9:13", "--out", str(out), "--json"]) == 0
     result = json.loads(capsys.readouterr().out)
     params, tuning = load_params(out)
     assert result["method"] == tuning["method"] == "tpe"
     assert params.border == "clip"
-    assert main(["tune", "--windows", "9:13", "--border", "invalid", "--out", str(out)]) == 0
+    assert main(["tune", "--block-sizes", "9:13", "--border", "invalid", "--out", str(out)]) == 0
     assert load_params(out)[0].border == "invalid"  # what the user names wins
 
 
 def test_tuned_params_round_trip_into_eval(tmp_path: Path, capsys) -> None:
     out = tmp_path / "p.toml"
-    assert main(["tune", "--method", "grid", "--windows", "9:13", "--out", str(out)]) == 0
+    assert main(["tune", "--method", "grid", "--block-sizes", "9:13", "--out", str(out)]) == 0
     capsys.readouterr()
     assert main(["eval", "--params", str(out), "--json"]) == 0
     row = json.loads(capsys.readouterr().out)
@@ -95,7 +95,7 @@ def _run(*argv: str) -> tuple[int, str]:
     (["--method", "nope"], "invalid choice"),
     (["--iterations", "0"], "at least 1"),
     (["--space", "sad", "--method", "paper"], "tunes one parameter"),
-    (["--windows", "4:10"], "odd bounds"),
+    (["--block-sizes", "4:10"], "odd bounds"),
     (["--alpha", "0.5", "--method", "paper"], "belong to --method qlearning"),
     (["--method", "grid", "--gamma", "0.5"], "takes no learning parameters"),
 ])
@@ -119,7 +119,7 @@ def test_an_interrupted_run_leaves_no_params_file(tmp_path: Path) -> None:
 
 
 def test_parallel_workers_give_the_same_result_as_one_process(scene) -> None:
-    space = make_space("window", MatcherParams(num_disparities=32), odd_range("5:11"))
+    space = make_space("block-size", MatcherParams(num_disparities=32), odd_range("5:11"))
     one = gt_objective([scene], space)
     two = gt_objective([scene], space, workers=2)
     try:
@@ -130,7 +130,7 @@ def test_parallel_workers_give_the_same_result_as_one_process(scene) -> None:
 
 
 def test_learning_parameters_reach_the_learner(capsys) -> None:
-    argv = ["tune", "--method", "qlearning", "--iterations", "12", "--windows", "7:13",
+    argv = ["tune", "--method", "qlearning", "--iterations", "12", "--block-sizes", "7:13",
             "--json", "--seed", "2"]
     assert main(argv + ["--epsilon", "0.0", "--episodes", "1"]) == 0
     greedy = json.loads(capsys.readouterr().out)["history"]
@@ -146,7 +146,7 @@ def test_the_job_runs_without_writing_and_the_report_writes(tmp_path: Path, caps
     from host.commands.tune import TuneJob, report, run_job
 
     out = tmp_path / "p.toml"
-    args = build_parser("host").parse_args(["tune", "--method", "grid", "--windows", "7:11",
+    args = build_parser("host").parse_args(["tune", "--method", "grid", "--block-sizes", "7:11",
                                             "--out", str(out)])
     job = TuneJob.from_args(args)
     assert (job.method, job.iterations, [s.name for s in job.tuned_on]) == \
@@ -156,4 +156,4 @@ def test_the_job_runs_without_writing_and_the_report_writes(tmp_path: Path, caps
     assert done.result.evaluations == 3 and done.best.block_size in (7, 9, 11)
     report(job, done)
     assert load_params(out)[0] == done.best
-    assert capsys.readouterr().out.startswith("grid on window over motorcycle: best ")
+    assert capsys.readouterr().out.startswith("grid on block-size over motorcycle: best ")

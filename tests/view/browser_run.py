@@ -50,7 +50,7 @@ def read_dom(page) -> dict:
 def main(out: Path) -> None:
     out.mkdir(parents=True, exist_ok=True)
     cmd = [sys.executable, "-m", "host", "servo", "--sim", "--view", "127.0.0.1:0",
-           "--settle", "0", "--duration", "600", "--border", "clip", "--num-disp", "48",
+           "--settle", "0", "--duration", "600", "--border", "clip", "--num-disparities", "48",
            "--start-depth", "1.9", "--log", str(out / "run.csv")]
     proc = subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True)
     lines: list[str] = []

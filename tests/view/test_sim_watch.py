@@ -59,7 +59,8 @@ async def _one_update(url: str) -> dict:
 
 def _servo(*extra: str) -> subprocess.Popen:
     return subprocess.Popen([sys.executable, "-m", "host", "servo", "--sim", "--view",
-                             "--settle", "0", "--border", "clip", "--num-disp", "48", *extra],
+                             "--settle", "0", "--border", "clip", "--num-disparities", "48",
+                             *extra],
                             stderr=subprocess.PIPE, text=True)
 
 
@@ -114,7 +115,7 @@ def test_host_view_says_when_a_replay_has_ended(tmp_path: Path) -> None:
         cv2.imwrite(str(tmp_path / f"left_{i:03d}.png"), pair.left)
         cv2.imwrite(str(tmp_path / f"right_{i:03d}.png"), pair.right)
     proc = subprocess.Popen([sys.executable, "-m", "host", "view", "--camera",
-                             f"replay:{tmp_path}", "--border", "clip", "--num-disp", "48",
+                             f"replay:{tmp_path}", "--border", "clip", "--num-disparities", "48",
                              "--duration", "120"], stderr=subprocess.PIPE, text=True)
     try:
         lines = Lines(proc)

@@ -30,7 +30,7 @@ def _recording(folder: Path, frames: int = 3) -> None:
 
 def test_view_shows_a_recording_without_stop(tmp_path: Path) -> None:
     _recording(tmp_path)
-    with host_view("--camera", f"replay:{tmp_path}", "--border", "clip", "--num-disp", "48",
+    with host_view("--camera", f"replay:{tmp_path}", "--border", "clip", "--num-disparities", "48",
                    "--duration", "60") as url:
         async def one_update() -> tuple[dict, list[bytes]]:
             async with aiohttp.ClientSession() as s, s.ws_connect(f"ws://{url}/updates") as ws:
