@@ -54,7 +54,7 @@ def census_ad_volume(cl, cr, pl, pr, dmin, weight, cap, outside, out):
             o = out[y, x]
             for j in range(n):
                 xr = x - dmin - j
-                diff = 0
+                diff = np.int32(0)
                 for c in range(ch):
                     diff += abs(np.int32(pl[c, y, x]) - np.int32(pr[c, y, xr]))
                 o[j] = np.uint16(_popcount(a ^ rrow[xr])) + table[diff]

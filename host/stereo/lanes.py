@@ -80,8 +80,8 @@ def splat(typingctx, x):
         return None
 
     def codegen(context, builder, sig, args):
-        s = builder.trunc(args[0], _I16) if x.bitwidth > 16 else (
-            builder.zext(args[0], _I16) if x.bitwidth < 16 else args[0])
+        s = builder.trunc(args[0], _I16) if args[0].type.width > 16 else (
+            builder.zext(args[0], _I16) if args[0].type.width < 16 else args[0])
         v = builder.insert_element(ir.Constant(_VEC, ir.Undefined), s, ir.Constant(
             ir.IntType(32), 0))
         return builder.shuffle_vector(v, ir.Constant(_VEC, ir.Undefined),
@@ -133,7 +133,7 @@ def select_ge(typingctx, k, a, b):
         return None
 
     def codegen(context, builder, sig, args):
-        kk = builder.trunc(args[0], _I16) if k.bitwidth > 16 else args[0]
+        kk = builder.trunc(args[0], _I16) if args[0].type.width > 16 else args[0]
         kv = builder.shuffle_vector(
             builder.insert_element(ir.Constant(_VEC, ir.Undefined), kk,
                                    ir.Constant(ir.IntType(32), 0)),

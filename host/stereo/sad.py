@@ -21,6 +21,11 @@ from host.stereo.block_matching import _argmin, _decide, padded_pair
 from host.stereo.subpixel import FIT_NONE, fit_offset
 
 TILE_BYTES = 8192  # column sums updated per tile: well inside a 32 KiB L1 with the pixel rows
+# The window's candidate lanes are nd rounded up to a multiple of LANES (a 512-bit vector of
+# uint16) and the interior's loops over them run in stretches of at most LANES: with that bound
+# known, LLVM makes each stretch one vector, where a loop of unknown length gets a 4-way
+# interleaved body of 128 lanes whose 8-lane and scalar remainder took every count below 128
+LANES = 32
 
 
 def lane_types(channels: int, size: int) -> tuple[type, type]:
@@ -70,22 +75,71 @@ def _cols_slide(col, left, right_p, y_new, y_old, x0, x1, base0, nd):
 
 
 @njit(cache=True, fastmath=True, inline="always")
-def _slide_min(win, enter, leave, idx):
-    """Window sums move one column right; returns the smallest candidate of the lowest sum.
-
-    Every comparison is between values of the window's own dtype (a uint16 against an int64
-    would go through float64 in numba), so all three loops run in full-width vector lanes.
-    """
-    for k in range(win.size):
-        win[k] = win[k] + enter[k] - leave[k]
-    m = win[0]
-    for k in range(1, win.size):
-        m = min(m, win[k])
-    none = idx[win.size]  # idx = 0 .. nd in the window's dtype
+def _best_in(win, m, idx, k0):
+    # lanes k0 .. k0 + LANES - 1 (those below win.size): a loop bounded by LANES
+    none = idx[win.size]
     best = none
-    for k in range(win.size):
-        best = min(best, idx[k] if win[k] == m else none)
+    for j in range(min(win.size - k0, LANES)):
+        best = min(best, idx[k0 + j] if win[k0 + j] == m else none)
     return best
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _best(win, m, idx):
+    """The smallest candidate whose window sum is m. idx holds 0 .. nd - 1, then nd ("none")
+    on the lanes past the real candidates and at idx[win.size]."""
+    n = win.size
+    best = idx[n]
+    for k in range(4 * LANES, n):  # past four stretches: a plain loop
+        best = min(best, idx[k] if win[k] == m else idx[n])
+    # the stretches' own results, taken apart so they do not wait on each other
+    b0 = _best_in(win, m, idx, 0)
+    b1 = _best_in(win, m, idx, LANES)
+    b2 = _best_in(win, m, idx, 2 * LANES)
+    b3 = _best_in(win, m, idx, 3 * LANES)
+    return min(best, min(min(b0, b1), min(b2, b3)))
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _lowest(win, floor, idx):
+    """(the smallest candidate of the lowest window sum, that sum).
+
+    floor lifts the lanes past the real candidates to the window dtype's top (as does
+    floor[win.size]). Every comparison is between values of the window's own dtype (a uint16
+    against an int64 would go through float64 in numba), so the loops run in full vectors.
+    """
+    m = floor[win.size]
+    for k in range(win.size):
+        m = min(m, max(win[k], floor[k]))
+    return _best(win, m, idx), m
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _slide_min_in(win, floor, col, e, o, k0):
+    # lanes k0 .. k0 + LANES - 1 (those below win.size): a loop bounded by LANES
+    m = floor[win.size]
+    for j in range(min(win.size - k0, LANES)):
+        k = k0 + j
+        win[k] = win[k] + col[e, k] - col[o, k]
+        m = min(m, max(win[k], floor[k]))
+    return m
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _slide_lowest(win, floor, idx, col, e, o):
+    """The window moves one column right (column e enters, column o leaves), its minimum
+    taken in the same pass, in stretches of LANES; then as _lowest."""
+    n = win.size
+    # the stretches' own minima, taken apart so they do not wait on each other
+    m0 = _slide_min_in(win, floor, col, e, o, 0)
+    m1 = _slide_min_in(win, floor, col, e, o, LANES)
+    m2 = _slide_min_in(win, floor, col, e, o, 2 * LANES)
+    m3 = _slide_min_in(win, floor, col, e, o, 3 * LANES)
+    m = min(min(m0, m1), min(m2, m3))
+    for k in range(4 * LANES, n):  # past four stretches: a plain loop
+        win[k] = win[k] + col[e, k] - col[o, k]
+        m = min(m, max(win[k], floor[k]))
+    return _best(win, m, idx), m
 
 
 @njit(cache=True, fastmath=True, inline="always")
@@ -95,23 +149,13 @@ def _slide(win, enter, leave):
 
 
 @njit(cache=True, fastmath=True, inline="always")
-def _interior(col, win, idx, out, yi, x_from, x_to, half, dmin, nd, fit):
+def _interior(col, win, floor, idx, out, yi, x_from, x_to, half, dmin, nd, fit):
     """The common case: both window columns inside, every candidate allowed, no uniqueness.
 
     Reads the column sums by index (no views) and fuses the slide with the minimum.
     """
-    none = idx[nd]
     for x in range(x_from, x_to):
-        e = x + half
-        o = x - half - 1
-        win[0] = win[0] + col[e, 0] - col[o, 0]
-        m = win[0]
-        for k in range(1, nd):
-            win[k] = win[k] + col[e, k] - col[o, k]
-            m = min(m, win[k])
-        best = none
-        for k in range(nd):
-            best = min(best, idx[k] if win[k] == m else none)
+        best, m = _slide_lowest(win, floor, idx, col, x + half, x - half - 1)
         off = 0.0
         if fit != FIT_NONE and 0 < best < nd - 1:
             off = fit_offset(np.float32(win[best - 1]), np.float32(m),
@@ -120,8 +164,8 @@ def _interior(col, win, idx, out, yi, x_from, x_to, half, dmin, nd, fit):
 
 
 @njit(cache=True, fastmath=True)
-def _row_outputs(col, win, zero, idx, rowcost, out, yi, x_from, x_to, x_start, half, w, dmin,
-                 nd, top, uniqueness, fit, want_right):
+def _row_outputs(col, win, zero, floor, idx, rowcost, out, yi, x_from, x_to, x_start, half, w,
+                 dmin, nd, top, uniqueness, fit, want_right):
     """Slide the window over outputs x in [x_from, x_to) of one row, writing out[yi, x]."""
     if x_from == x_start:
         win[:] = 0
@@ -135,7 +179,7 @@ def _row_outputs(col, win, zero, idx, rowcost, out, yi, x_from, x_to, x_start, h
     x = x_from
     while x < x_to:
         if x == fast_lo:
-            _interior(col, win, idx, out, yi, fast_lo, fast_hi, half, dmin, nd, fit)
+            _interior(col, win, floor, idx, out, yi, fast_lo, fast_hi, half, dmin, nd, fit)
             x = fast_hi
             continue
         enter = col[x + half] if x + half < w else zero
@@ -144,17 +188,17 @@ def _row_outputs(col, win, zero, idx, rowcost, out, yi, x_from, x_to, x_start, h
         dmax = max(0, x - half) - dmin
         kmin = max(0, nd - 1 - dmax)
         x += 1
+        _slide(win, enter, leave)
         if kmin == 0:
-            k = _slide_min(win, enter, leave, idx)
+            k, _ = _lowest(win, floor, idx)
         else:
-            _slide(win, enter, leave)
             if dmax < 0:
                 if want_right:
                     rowcost[x - 1, :] = top
                 continue
             k = _argmin(win, kmin, nd)
         if want_right:
-            rowcost[x - 1, :] = win
+            rowcost[x - 1, :] = win[:nd]
             rowcost[x - 1, :kmin] = top
         off, ok = _decide(win, k, kmin, nd, uniqueness, fit)
         if ok:
@@ -199,22 +243,25 @@ def match_sad(left, right, dmin, nd, half, uniqueness, fit, want_right, clip, co
     cdt = col_proto.dtype
     wdt = win_proto.dtype
     tile = max(2 * half + 2, TILE_BYTES // (nd * col_proto.itemsize))
+    ndp = -(-nd // LANES) * LANES  # the window's lanes; past nd they stay 0 and never win
     nbands = max(1, min(rows, nbands))
     for band in prange(nbands):
         y0 = half + rows * band // nbands
         y1 = half + rows * (band + 1) // nbands
-        col = np.zeros((w, nd), dtype=cdt)
-        win = np.zeros(nd, dtype=wdt)
-        zero = np.zeros(nd, dtype=cdt)
-        idx = np.arange(nd + 1).astype(wdt)
+        col = np.zeros((w, ndp), dtype=cdt)  # _cols_* update lanes 0 .. nd - 1 only
+        win = np.zeros(ndp, dtype=wdt)
+        zero = np.zeros(ndp, dtype=cdt)
+        floor = np.zeros(ndp + 1, dtype=wdt)
+        floor[nd:] = top
+        idx = np.minimum(np.arange(ndp + 1), nd).astype(wdt)
         rowcost = np.full((w if want_right else 1, nd), top, dtype=wdt)
         for yy in range(y0 - half, y0 + half + 1):
             _cols_add(col, left_p, right_p, yy, 0, w, base0, nd)
         for y in range(y0, y1):
             yi = y - ro  # image row
             if y == y0:
-                _row_outputs(col, win, zero, idx, rowcost, disp_l, yi, x_start, x_end, x_start,
-                             half, w, dmin, nd, top, uniqueness, fit, want_right)
+                _row_outputs(col, win, zero, floor, idx, rowcost, disp_l, yi, x_start, x_end,
+                             x_start, half, w, dmin, nd, top, uniqueness, fit, want_right)
             else:
                 done = x_start
                 for tx0 in range(0, w, tile):
@@ -223,8 +270,9 @@ def match_sad(left, right, dmin, nd, half, uniqueness, fit, want_right, clip, co
                                 nd)
                     upto = x_end if tx1 == w else min(x_end, tx1 - half)
                     if upto > done:
-                        _row_outputs(col, win, zero, idx, rowcost, disp_l, yi, done, upto, x_start,
-                                     half, w, dmin, nd, top, uniqueness, fit, want_right)
+                        _row_outputs(col, win, zero, floor, idx, rowcost, disp_l, yi, done, upto,
+                                     x_start, half, w, dmin, nd, top, uniqueness, fit,
+                                     want_right)
                         done = upto
             if want_right:
                 _right_row(rowcost, disp_r, yi, w, x_start, x_end, dmin, nd, top, fit)

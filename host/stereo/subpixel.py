@@ -9,6 +9,9 @@ minimum; the parabola is the model of a squared cost (SSD) or a smooth correlati
 
 from __future__ import annotations
 
+from typing import Any
+
+import numpy as np
 from numba import njit
 
 FIT_NONE = 0
@@ -22,12 +25,14 @@ DEFAULT_FITS = {"sad": "parabola", "ssd": "parabola", "ncc": "parabola", "sgm": 
 
 
 @njit(cache=True, fastmath=True, inline="always")
-def fit_offset(cm: float, c0: float, cp: float, fit: int) -> float:
-    """Offset of the minimum from the centre sample, given costs before, at and after it."""
+def fit_offset(cm: float | np.floating[Any], c0: float | np.floating[Any],
+               cp: float | np.floating[Any], fit: int) -> float:
+    """Offset of the minimum from the centre sample, given costs before, at and after it
+    (float32 from the own matchers, whose arithmetic here numba does in float64)."""
     if fit == FIT_PARABOLA:
         den = cm - 2.0 * c0 + cp
-        return 0.5 * (cm - cp) / den if den > 0.0 else 0.0
+        return float(0.5 * (cm - cp) / den) if den > 0.0 else 0.0
     if fit == FIT_EQUIANGULAR:
         slope = max(cm, cp) - c0
-        return 0.5 * (cm - cp) / slope if slope > 0.0 else 0.0
+        return float(0.5 * (cm - cp) / slope) if slope > 0.0 else 0.0
     return 0.0

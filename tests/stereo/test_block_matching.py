@@ -8,6 +8,7 @@ import pytest
 
 from host.stereo import MatcherParams, compute_disparity
 from host.stereo.synthetic import Layer, random_texture, render_pair, synthetic_scene
+from tests.stereo import sad_reference, sgm_reference
 
 
 def shifted_pair(d: float, width: int = 160, height: int = 90, seed: int = 1):
@@ -59,6 +60,17 @@ def test_running_sums_equal_explicit_windows(size: int) -> None:
     want = _naive_sad(left, right, 12, size)
     np.testing.assert_array_equal(np.isnan(got), np.isnan(want))
     np.testing.assert_array_equal(got[np.isfinite(got)], want[np.isfinite(want)])
+
+
+@pytest.mark.parametrize("i", range(len(sad_reference.CONFIGS)))
+def test_sad_maps_equal_the_reference_written_before_the_speed_rework(i: int) -> None:
+    # sad_reference.npz holds sad.match_sad's maps at commit 85cf046 for every configuration
+    # (candidate counts 16..128, grey and colour, uint16 and int32 lanes, both borders, fits,
+    # uniqueness, LR's right map, one band or three)
+    stored = np.load(sad_reference.FILE)
+    left, right = sad_reference.run(sad_reference.CONFIGS[i])
+    np.testing.assert_array_equal(left, sgm_reference.unpack(stored[f"left{i}"]))
+    np.testing.assert_array_equal(right, sgm_reference.unpack(stored[f"right{i}"]))
 
 
 def test_border_invalid_never_uses_pixels_outside_the_image() -> None:
