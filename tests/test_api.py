@@ -66,7 +66,7 @@ def test_bad_images_raise_one_clear_input_error(scene, change, words: str) -> No
 
 @pytest.mark.parametrize("kwargs, words", [
     ({"matcher": "nope"}, "unknown matcher 'nope'"),
-    ({"block_size": 8}, "window must be odd"),
+    ({"block_size": 8}, "block size must be odd"),
     ({"window": 7}, "unknown matcher parameter"),
     ({"num_disparities": 16, "range_policy": "coarse"}, "not both"),
 ])

@@ -212,7 +212,7 @@ ROWS = [
     (["calibrate", "{replay}", "--square", "0"], "argument --square: must be > 0"),
     (["emulate", "--drop", "1"], "argument --drop: must be >= 0 and < 1"),
     # windows and ranges of the matcher
-    (DISP + ["-o", "{tmp}/o.png", "--block-size", "8"], "window must be odd"),
+    (DISP + ["-o", "{tmp}/o.png", "--block-size", "8"], "block size must be odd"),
     (DISP + ["-o", "{tmp}/o.png", "--block-size", "0"], "argument --block-size: must be >= 1"),
     (DISP + ["-o", "{tmp}/o.png", "--num-disparities", "900"], "wider than the image"),
     (DISP + ["-o", "{tmp}/o.png", "--uniqueness", "101"], "argument --uniqueness"),

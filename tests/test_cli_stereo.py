@@ -86,7 +86,7 @@ def test_eval_default_scene_prints_a_table_with_null_nonocc(capsys) -> None:
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["--block-size", "8"], "window must be odd"),
+    (["--block-size", "8"], "block size must be odd"),
     (["--block-size", "301"], "out of range"),
     (["--num-disparities", "900"], "wider than the image"),
     (["--matcher", "opencv-bm", "--num-disparities", "40"], "divisible by 16"),

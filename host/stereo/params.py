@@ -101,13 +101,13 @@ class MatcherParams:
         if self.matcher not in MATCHERS:
             raise HostError(f"unknown matcher {self.matcher!r} (choose from {', '.join(MATCHERS)})")
         if self.block_size < 1 or self.block_size % 2 == 0:
-            raise HostError(f"window must be odd and positive, got {self.block_size}")
+            raise HostError(f"block size must be odd and positive, got {self.block_size}")
         if self.block_size > 255 or (self.matcher == "opencv-bm" and not self.block_size >= 5):
-            raise HostError(f"window {self.block_size} is out of range for {self.matcher}")
+            raise HostError(f"block size {self.block_size} is out of range for {self.matcher}")
         if self.num_disparities < 1:
-            raise HostError(f"num-disp must be positive, got {self.num_disparities}")
+            raise HostError(f"num-disparities must be positive, got {self.num_disparities}")
         if self.matcher.startswith("opencv") and self.num_disparities % 16:
-            raise HostError(f"{self.matcher} needs num-disp divisible by 16, "
+            raise HostError(f"{self.matcher} needs num-disparities divisible by 16, "
                             f"got {self.num_disparities}")
         if self.lr_check is not None and self.lr_check < 0:
             raise HostError(f"lr-check tolerance must be >= 0 px, got {self.lr_check}")
@@ -116,7 +116,7 @@ class MatcherParams:
         if self.border not in BORDERS:
             raise HostError(f"unknown border {self.border!r} (choose from {', '.join(BORDERS)})")
         if not self.matcher.startswith("opencv") and self.min_disparity < 0:
-            raise HostError(f"min-disp must be >= 0 for {self.matcher}, got {self.min_disparity}")
+            raise HostError(f"min-disparity must be >= 0 for {self.matcher}, got {self.min_disparity}")
         if self.median not in (0, 3, 5):
             raise HostError(f"median must be 0, 3 or 5, got {self.median}")
         if self.subpixel_fit not in SUBPIXEL_FITS:
@@ -136,7 +136,7 @@ class MatcherParams:
             raise HostError(f"paths must be 4, 5 or 8 (own SGM), got {self.paths}")
         if width is not None:
             if self.block_size >= width:
-                raise HostError(f"window {self.block_size} is too large for an image "
+                raise HostError(f"block size {self.block_size} is too large for an image "
                                 f"{width} px wide")
             if self.min_disparity + self.num_disparities > width - self.block_size // 2:
                 raise HostError(f"disparity range {self.min_disparity}.."
