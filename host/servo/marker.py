@@ -91,9 +91,9 @@ def find_discs(image: np.ndarray, min_radius: float = 2.5, max_radius: float = 8
         return blobs
     # the cheapest tests first, on every outline at once: its bounding box's aspect, and the
     # contour's area is at most (w - 1)(h - 1) (cv2.boundingRect's box, from the points)
-    ends = np.cumsum([len(c) for c in outlines])
+    sizes = np.fromiter((c.shape[0] for c in outlines), np.intp, len(outlines))
     points = np.concatenate(outlines).reshape(-1, 2)
-    starts = ends - np.array([len(c) for c in outlines])
+    starts = np.cumsum(sizes) - sizes
     lo, hi = np.minimum.reduceat(points, starts), np.maximum.reduceat(points, starts)
     bw, bh = hi[:, 0] - lo[:, 0] + 1, hi[:, 1] - lo[:, 1] + 1
     keep = (bw / bh > 0.75) & (bw / bh < 1.33) & ((bw - 1) * (bh - 1) >= min_area)
@@ -108,8 +108,7 @@ def find_discs(image: np.ndarray, min_radius: float = 2.5, max_radius: float = 8
             continue
         r = (w + h) / 4
         u, v = _centroid(grey, x + (w - 1) / 2, y + (h - 1) / 2, r)
-        ring_px = _annulus(grey, u, v, 1.2 * r, 1.45 * r)
-        disc_px = _annulus(grey, u, v, 0.0, 0.7 * r)
+        ring_px, disc_px = _ring_and_disc(grey, u, v, r)
         # printed: a uniform light ring round a uniform dark disc (texture is neither); the
         # means first (exact from the integer sums), the deviations only if they pass
         ring = _mean(ring_px) if ring_px.size else 0.0
@@ -132,16 +131,20 @@ def _outlines(mask: np.ndarray, min_area: float) -> list[np.ndarray]:
     encloses at most (n sqrt 2)^2 / (4 pi) px, so shorter ones are dropped unmeasured."""
     contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
     shortest = math.sqrt(2 * math.pi * min_area)
-    return [c for c in contours if len(c) >= shortest]
+    return [c for c in contours if c.shape[0] >= shortest]
 
 
-def _annulus(grey: np.ndarray, cx: float, cy: float, r0: float, r1: float) -> np.ndarray:
-    """The grey levels between radii r0 and r1 (uint8, in row order)."""
+def _ring_and_disc(grey: np.ndarray, cx: float, cy: float, r: float
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """The grey levels (uint8, in row order) of the ring (1.2 r to 1.45 r from the centre) and
+    of the disc (within 0.7 r), from one window and one grid of squared distances."""
     h, w = grey.shape
+    r0, r1, rd = 1.2 * r, 1.45 * r, 0.7 * r
     x0, x1 = max(0, int(cx - r1) - 1), min(w, int(cx + r1) + 2)
     y0, y1 = max(0, int(cy - r1) - 1), min(h, int(cy + r1) + 2)
     d2 = ((np.arange(x0, x1) - cx) ** 2)[None, :] + ((np.arange(y0, y1) - cy) ** 2)[:, None]
-    return grey[y0:y1, x0:x1][(d2 >= r0 * r0) & (d2 <= r1 * r1)]
+    patch = grey[y0:y1, x0:x1]
+    return patch[(d2 >= r0 * r0) & (d2 <= r1 * r1)], patch[d2 <= rd * rd]
 
 
 def _mean(values: np.ndarray) -> float:
