@@ -15,7 +15,7 @@ export STEREO_SERVO_DATA ?= $(if $(wildcard $(DATA)/middlebury/index.json),$(DAT
 $(BIN)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --disable-pip-version-check -e '.[test,ray]'
-	$(BIN)/python -m host.stereo.warm  # numba compiles now, not in the user's first run
+	$(BIN)/python -m host.stereo.warm  # numba compiles now (2 processes), not in the user's first run
 	touch $@
 
 venv: $(BIN)/.installed
@@ -41,8 +41,11 @@ demo: venv
 	$(BIN)/host servo --sim --border clip --num-disp 48 --log $(OUT)/servo.csv --plot $(OUT)/servo.png
 	@echo "pictures: $(OUT)/motorcycle.png (disparity), $(OUT)/tuning.png (tuning), $(OUT)/servo.png (servo run)"
 
+# pytest-xdist: TEST_WORKERS processes, each test file whole on one of them (tests/conftest.py
+# says what files share and how that is kept safe); TEST_WORKERS=0 runs in this process
+TEST_WORKERS ?= 2
 test: venv system-deps browser-deps platformio lint typecheck
-	$(BIN)/python -m pytest --durations=20
+	$(BIN)/python -m pytest -n $(TEST_WORKERS) --dist loadfile --durations=20
 
 lint: venv
 	$(BIN)/ruff check host tools bench tests

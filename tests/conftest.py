@@ -1,8 +1,11 @@
-"""Shared fixtures: where the Middlebury reference scenes are (STEREO_SERVO_DATA)."""
+"""Shared fixtures (where the Middlebury reference scenes are: STEREO_SERVO_DATA), the slow
+tiers, and what makes two pytest-xdist workers safe side by side (make test runs -n 2)."""
 
 from __future__ import annotations
 
+import contextlib
 import os
+import time
 from pathlib import Path
 
 import pytest
@@ -132,3 +135,98 @@ def pytest_collection_modifyitems(config, items) -> None:
         rel = Path(str(item.fspath)).resolve().relative_to(ROOT).as_posix()
         if _is_slow(rel, item.name):
             item.add_marker(pytest.mark.slow)
+
+
+# ---- two workers side by side (pytest-xdist; make test runs -n 2 --dist loadfile) ----------
+# Each file runs whole on one worker (its module fixtures, ports and files stay its own). What
+# files share is made safe here: the firmware ELFs are built once before the workers start
+# (every later make finds them up to date), each worker's Ray keeps its session files apart,
+# and numba's cache is read and written under a lock (host.stereo.warm.lock_cache_files).
+WORKER = os.environ.get("PYTEST_XDIST_WORKER")
+if WORKER:
+    os.environ.setdefault("RAY_TMPDIR", f"/tmp/ray-{WORKER}")  # short: Ray's socket paths
+
+
+def pytest_sessionstart(session) -> None:
+    if session.config.pluginmanager.hasplugin("dsession"):  # the controller, before workers
+        from host.emulator import build
+        from host.errors import HostError
+        for test_hang in (False, True):
+            # on an error the fixtures build again and skip (tool missing) or fail with it
+            with contextlib.suppress(HostError):
+                build.firmware_elf(test_hang)
+
+
+class _NumbaCompiles:
+    """Records the numba kernels compiled (not loaded from the cache) during each test: the
+    warm step (python -m host.stereo.warm) should have compiled them, and compiling costs a
+    test tens of seconds."""
+
+    def __init__(self) -> None:
+        self.depth, self.t0, self.seconds, self.names = 0, 0.0, 0.0, []
+
+    def on_start(self, event) -> None:
+        if self.depth == 0:
+            self.t0 = time.perf_counter()
+        self.depth += 1
+        func = event.data["dispatcher"].py_func
+        if not func.__module__.startswith("numba"):  # ours, not numba's own overloads
+            self.names.append(f"{func.__module__}.{func.__qualname__}")
+
+    def on_end(self, event) -> None:
+        self.depth -= 1
+        if self.depth == 0:
+            self.seconds += time.perf_counter() - self.t0
+
+    def take(self) -> tuple[float, list[str]]:
+        got = (self.seconds, sorted(set(self.names)))
+        self.seconds, self.names = 0.0, []
+        return got
+
+
+def _numba_listener() -> _NumbaCompiles | None:
+    try:
+        from numba.core import event
+    except ImportError:
+        return None
+    from host.stereo.warm import lock_cache_files
+    lock_cache_files()
+    log = _NumbaCompiles()
+
+    class Listener(event.Listener):
+        def on_start(self, ev) -> None:
+            log.on_start(ev)
+
+        def on_end(self, ev) -> None:
+            log.on_end(ev)
+
+    event.register("numba:compile", Listener())
+    return log
+
+
+_COMPILES = _numba_listener()
+_COMPILED: dict[tuple[str, str], tuple[float, list[str]]] = {}  # (nodeid, phase)
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    if _COMPILES is not None:
+        seconds, names = _COMPILES.take()
+        if names:  # carried to the controller in the report (pytest-xdist)
+            item.user_properties.append(("numba compiled", (call.when, round(seconds, 1), names)))
+    yield
+
+
+def pytest_runtest_logreport(report) -> None:
+    for key, value in report.user_properties:  # a phase's entry comes again in later reports
+        if key == "numba compiled":
+            when, seconds, names = value
+            _COMPILED[(report.nodeid, when)] = (seconds, names)
+
+
+def pytest_terminal_summary(terminalreporter) -> None:
+    if not _COMPILED:
+        return
+    terminalreporter.section("numba compiled during tests (not in the warm step's cache)")
+    for (nodeid, when), (seconds, names) in sorted(_COMPILED.items(), key=lambda kv: -kv[1][0]):
+        terminalreporter.write_line(f"{seconds:7.1f} s {when:8} {nodeid}: {', '.join(names)}")

@@ -3,12 +3,20 @@
 `python -m host.stereo.warm` (the Makefile's venv step runs it) calls each own matcher on a
 small random pair with every lane width, channel count and option that selects a different
 compiled signature, so the first `host eval` loads machine code instead of compiling it.
+The variants are shared among `--processes` processes (default: one per core, at most 2):
+compiling is single-threaded, and the two 4-path SGM signatures alone take most of the time.
 """
 
 from __future__ import annotations
 
+import argparse
+import fcntl
+import os
+import subprocess
 import sys
 import time
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -17,25 +25,31 @@ from host.stereo.params import MatcherParams
 
 
 def variants() -> list[MatcherParams]:
-    """Parameter sets covering the compiled signatures (lane types, LR check, box sums)."""
-    out = []
+    """Parameter sets covering the compiled signatures (lane types, LR check, box sums). The
+    two slowest to compile come first, so that two processes (part 0 and 1, every other
+    variant) each take one of them."""
+    sgm = MatcherParams.for_matcher("sgm")
+    # SGM: the defaults (4 paths, costs and P2 within a byte: 1-byte stored rows), then
+    # 4 paths with a window over 1 (box-summed costs over a byte: 2-byte stored rows, as
+    # P2 or the intensity weight raised far enough give too), then 5 paths with the LR check
+    out = [sgm, sgm.replace(block_size=3),
+           MatcherParams(matcher="sgm", block_size=1, lr_check=1.0, fill=True),
+           MatcherParams(matcher="sgm", block_size=3, uniqueness_ratio=10)]
     # SAD lanes: (uint16, uint16), (uint16, int32) and (int32, int32) column/window sums
     for colour, window in [(False, 5), (False, 21), (True, 9), (True, 15), (True, 87)]:
         out.append(MatcherParams(matcher="sad", block_size=window, colour=colour))
     out += [MatcherParams(matcher="sad", lr_check=1.0, uniqueness_ratio=10, fill=True, median=5,
                           border="clip"),
             MatcherParams(matcher="ssd", lr_check=1.0),
-            MatcherParams(matcher="ncc", block_size=5, lr_check=1.0, border="clip"),
-            MatcherParams(matcher="sgm", block_size=1, lr_check=1.0, fill=True),
-            MatcherParams(matcher="sgm", block_size=3, uniqueness_ratio=10),
-            MatcherParams.for_matcher("sgm")]  # the cost volume with the intensity term
+            MatcherParams(matcher="ncc", block_size=5, lr_check=1.0, border="clip")]
     return out
 
 
-def warm() -> int:
-    """Run every variant once on a small random colour pair; returns how many ran."""
+def warm(part: int = 0, parts: int = 1) -> int:
+    """Run every parts-th variant from part on once on a small random colour pair; returns how
+    many ran."""
     rng = np.random.default_rng(0)
-    ps = variants()
+    ps = variants()[part::parts]
     for p in ps:
         size = (40, 64 + p.block_size + 16, 3)
         left = rng.integers(0, 256, size, dtype=np.uint8)
@@ -44,11 +58,57 @@ def warm() -> int:
     return len(ps)
 
 
-def main() -> int:
+def lock_cache_files() -> None:
+    """Make numba's cache updates safe between processes compiling at once (the warm step's
+    parts, pytest's workers). numba's IndexDataCacheFile.save reads a function's index, adds
+    its new signature with the first free data file number and writes both back; two processes
+    adding different signatures of one function at once can both take number 1, and the index
+    then names the other signature's machine code. Each save and load here holds an exclusive
+    lock on a file beside the function's index for its read-modify-write."""
+    from numba.core import caching
+
+    cls: Any = caching.IndexDataCacheFile
+    if getattr(cls, "locked_by_stereo_servo", False):
+        return
+
+    def locked(fn: Callable[..., Any]) -> Callable[..., Any]:
+        def run(self: Any, *args: Any) -> Any:
+            os.makedirs(self._cache_path, exist_ok=True)
+            with open(self._index_path + ".lock", "a") as f:
+                fcntl.flock(f, fcntl.LOCK_EX)
+                return fn(self, *args)
+        return run
+
+    cls.save, cls.load = locked(cls.save), locked(cls.load)
+    cls.locked_by_stereo_servo = True
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m host.stereo.warm", description=__doc__)
+    ap.add_argument("--processes", type=int, default=min(2, os.cpu_count() or 1),
+                    help="processes compiling at once (default: cores, at most 2)")
+    ap.add_argument("--part", type=int, default=None, help=argparse.SUPPRESS)
+    args = ap.parse_args(argv)
+    if args.processes < 1:
+        print(f"--processes must be at least 1, got {args.processes}", file=sys.stderr)
+        return 2
+    lock_cache_files()
     t0 = time.perf_counter()
-    n = warm()
-    print(f"numba kernels compiled or loaded from cache: {n} matcher variants, "
-          f"{time.perf_counter() - t0:.1f} s", file=sys.stderr)
+    if args.part is not None:  # one of the processes below
+        warm(args.part, args.processes)
+        return 0
+    if args.processes == 1:
+        n = warm()
+    else:
+        parts = [subprocess.Popen([sys.executable, "-m", "host.stereo.warm", "--processes",
+                                   str(args.processes), "--part", str(k)])
+                 for k in range(args.processes)]
+        if any(p.wait() for p in parts):
+            print("a warm-up process failed (above)", file=sys.stderr)
+            return 1
+        n = len(variants())
+    print(f"numba kernels compiled or loaded from cache: {n} matcher variants in "
+          f"{args.processes} processes, {time.perf_counter() - t0:.1f} s", file=sys.stderr)
     return 0
 
 

@@ -67,7 +67,9 @@ class OldRobot:
 def robot(monkeypatch) -> tuple[RobotLink, OldRobot]:
     fake = OldRobot()
     monkeypatch.setattr("serial.serial_for_url", lambda *a, **k: fake)
-    link = RobotLink("fake://", reply_timeout_s=0.02).open()
+    # the fake answers at once: the timeout only runs out on a lost ACK, or when a loaded
+    # machine (two test workers beside other jobs) pauses this process longer than it
+    link = RobotLink("fake://", reply_timeout_s=0.5).open()
     return link, fake
 
 
