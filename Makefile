@@ -36,9 +36,9 @@ platformio: venv system-deps
 demo: venv
 	@mkdir -p $(OUT)
 	$(BIN)/host eval --picture $(OUT)
-	$(BIN)/host eval --matcher ncc --window 5 --border clip --lr-check 1 --fill --median 5
+	$(BIN)/host eval --matcher ncc --block-size 5 --border clip --lr-check 1 --fill --median 5
 	$(BIN)/host tune --method paper --border clip --out $(OUT)/tuned.toml --plot $(OUT)/tuning.png
-	$(BIN)/host servo --sim --border clip --num-disp 48 --log $(OUT)/servo.csv --plot $(OUT)/servo.png
+	$(BIN)/host servo --sim --border clip --num-disparities 48 --log $(OUT)/servo.csv --plot $(OUT)/servo.png
 	@echo "pictures: $(OUT)/motorcycle.png (disparity), $(OUT)/tuning.png (tuning), $(OUT)/servo.png (servo run)"
 
 # pytest-xdist: TEST_WORKERS processes, each test file whole on one of them (tests/conftest.py
