@@ -116,7 +116,8 @@ class MatcherParams:
         if self.border not in BORDERS:
             raise HostError(f"unknown border {self.border!r} (choose from {', '.join(BORDERS)})")
         if not self.matcher.startswith("opencv") and self.min_disparity < 0:
-            raise HostError(f"min-disparity must be >= 0 for {self.matcher}, got {self.min_disparity}")
+            raise HostError(f"min-disparity must be >= 0 for {self.matcher}, "
+                            f"got {self.min_disparity}")
         if self.median not in (0, 3, 5):
             raise HostError(f"median must be 0, 3 or 5, got {self.median}")
         if self.subpixel_fit not in SUBPIXEL_FITS:
