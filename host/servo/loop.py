@@ -68,7 +68,12 @@ from host.servo.perception import (
 )
 from host.servo.recovery import LANE, MOVED, RESET, RESUME, TARGET, Recovery, servo_bounds
 from host.servo.recovery import OUTSIDE as OUTSIDE_KIND
-from host.servo.rereference import fill_hidden, refit_floor, rereference_fault
+from host.servo.rereference import (
+    fill_hidden,
+    refit_floor,
+    rereference_fault,
+    target_shift_rows,
+)
 from host.servo.rig import reference_image, vertical_shift_px
 from host.servo.snapshot import Observer, Snapshot, link_stats
 from host.servo.timing import FrameTiming, TimingConfig
@@ -804,7 +809,11 @@ class Servo:
         except HostError as e:
             return str(e)
         agree = views_agree(frame.left, frame.right, target.bbox, target.disparity)
-        why = rereference_fault(self.floor, floor, dy, old, target, agree)
+        rows = target_shift_rows(self._reference_image, frame.left, old.bbox,
+                                 int(abs(dy)) + 4)
+        why = rereference_fault(self.floor, floor, dy, old, target, agree,
+                                moved_rows=self.cfg.moved_rows * self.geometry.focal_px,
+                                target_rows=rows)
         if why:
             return why
         k, lane = self._lane_scale, self._lane_geometry

@@ -3,10 +3,16 @@ picture's shift (host/servo/rereference.py): constructed targets, floors and map
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 
 from host.servo.perception import Floor, Target
-from host.servo.rereference import fill_hidden, horizon_row, rereference_fault
+from host.servo.rereference import (
+    fill_hidden,
+    horizon_row,
+    rereference_fault,
+    target_shift_rows,
+)
 
 OLD_FLOOR = Floor(0.24, -28.5)  # horizon at row 118.75
 TARGET = Target(17.5, 6000, (22, 81, 89, 75), 0.1)  # the box the robot drives to
@@ -79,3 +85,39 @@ def test_the_robots_region_is_filled_from_the_old_reference_moved_by_the_shift()
     assert np.isfinite(filled[100:180, 140:200]).all()
     np.testing.assert_array_equal(filled[100:180, 140:200], old[113:193, 140:200])
     assert np.array_equal(filled[:100], new[:100])  # outside the region: as it was
+
+
+def test_a_picture_that_did_not_move_is_no_re_reference():
+    """The floor's rows read as moved while the picture did not move (a large box put down
+    near the camera; the phase correlation read -18 rows for a moment and -0.3 at the
+    re-reference): the scene changed, not the camera, and nothing is re-referenced."""
+    new = Target(17.5, 6000, (22, 81, 89, 75), 0.1)
+    why = rereference_fault(OLD_FLOOR, OLD_FLOOR, -0.3, TARGET, new, 0.9, moved_rows=1.4)
+    assert why.startswith("the picture did not move"), why
+    assert rereference_fault(OLD_FLOOR, _pitched(OLD_FLOOR, UP), UP, TARGET,
+                             Target(17.43, 6279, (22, 67, 89, 76), 0.12), 0.9,
+                             moved_rows=1.4) == ""
+
+
+def test_the_targets_picture_is_found_where_the_picture_moved_and_only_there():
+    rng = np.random.default_rng(1)
+    scene = cv2.GaussianBlur(rng.uniform(0, 255, (240, 320)).astype(np.float32), (5, 5), 1.5)
+    box = (40, 80, 80, 70)
+    moved = np.roll(scene, -13, axis=0) + rng.normal(0, 3, scene.shape).astype(np.float32)
+    assert target_shift_rows(scene, moved.astype(np.uint8), box, 17) == -13
+    assert target_shift_rows(scene, scene.astype(np.uint8), box, 17) == 0
+    other = rng.uniform(0, 255, (240, 320)).astype(np.uint8)  # something else stands there
+    assert np.isnan(target_shift_rows(scene, other, box, 17))
+
+
+def test_a_target_whose_picture_did_not_move_with_the_picture_is_no_re_reference():
+    """A large box put down 30 cm in front of the robot: the floor's rows and, for a moment,
+    the phase correlation read an 18-row move; the box (the target then) stood where it was."""
+    new = Target(27.9, 9000, (60, 40, 200, 150), 0.1)
+    old = Target(27.9, 9000, (60, 58, 200, 150), 0.1)
+    floor = _pitched(OLD_FLOOR, -18.2)
+    why = rereference_fault(OLD_FLOOR, floor, -18.2, old, new, 0.9, target_rows=0.0)
+    assert why.startswith("the target's picture moved +0 rows"), why
+    why = rereference_fault(OLD_FLOOR, floor, -18.2, old, new, 0.9, target_rows=float("nan"))
+    assert why == "the target's picture is not where the picture's shift puts it", why
+    assert rereference_fault(OLD_FLOOR, floor, -18.2, old, new, 0.9, target_rows=-18.0) == ""
