@@ -737,8 +737,9 @@ class Servo:
         if verdict == RESUME:  # a moved camera moved no robot: its estimate goes on
             self._reacquire(probe=kind == RESET, why=reason, keep_estimate=kind == MOVED)
             return ""
-        if rec.fault:
-            self.stop_reason = self.stop_reason or rec.fault
+        if rec.fault:  # the wait outlasted its bound: the step decides the stop that ends
+            self.stop_reason = self.stop_reason or rec.fault  # the run (its phase "stop")
+            return ""
         return f"waiting ({kind}): {reason}"
 
     def _reacquire(self, probe: bool, why: str, keep_estimate: bool = False) -> None:
