@@ -116,6 +116,12 @@ SLOW_TESTS = {
         "a closed-loop run",
     "tests/sim/test_recover_events.py::test_a_camera_knocked_more_often_than_the_bound_ends_the_run_with_its_reason":
         "a closed-loop run",
+    "tests/sim/test_recover_events.py::test_at_the_defaults_a_knocked_camera_is_re_referenced_and_the_robot_holds":
+        "a closed-loop run",
+    "tests/sim/test_recover_events.py::test_a_look_alike_that_replaced_the_target_during_a_knock_is_no_re_reference":
+        "a closed-loop run",
+    "tests/sim/test_recover_events.py::test_a_knock_with_the_marker_hidden_ends_the_run_at_the_moved_bound":
+        "a closed-loop run",
     "tests/stereo/test_sgm.py::test_sgm_in_steady_state_takes_no_page_faults":
         "a fresh interpreter loading numba and matching 640x480 many times",
     "tests/tuning/test_tune_cli.py::test_parallel_workers_give_the_same_result_as_one_process":

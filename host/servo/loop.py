@@ -68,7 +68,12 @@ from host.servo.perception import (
 )
 from host.servo.recovery import LANE, MOVED, RESET, RESUME, TARGET, Recovery, servo_bounds
 from host.servo.recovery import OUTSIDE as OUTSIDE_KIND
-from host.servo.rereference import refit_floor
+from host.servo.rereference import (
+    fill_hidden,
+    refit_floor,
+    rereference_fault,
+    target_shift_rows,
+)
 from host.servo.rig import reference_image, vertical_shift_px
 from host.servo.snapshot import Observer, Snapshot, link_stats
 from host.servo.timing import FrameTiming, TimingConfig
@@ -129,8 +134,8 @@ class ServoConfig:
     lane_margin_m: float = 0.05  # watched beyond the stopping distance
     lane_stop_s: float = 3.0  # an object in the lane this long ends the run (recover=False)
     recover: bool = True  # wait out and recover from what passes (host/servo/recovery.py)
-    rereference: bool = False  # and re-reference after the camera moved: off until the
-    # collision it led to (seed 8 trial 45: knock, freeze, decoy) is understood
+    rereference: bool = True  # and re-reference after the camera moved (checked against
+    # the old reference moved by the picture's shift: rereference.py)
     moved_rows: float = 0.005  # of the focal length (0.3 degrees of pitch): the camera moved
     acquire_tries: int = 3  # look-alikes that do not move, left out one after the other
     lane_width_px: int = 320  # the lane is watched on frames scaled down to about this width
@@ -729,20 +734,23 @@ class Servo:
         clear = self._rereference_frame(frame, pair) if kind == MOVED else True
         reason = rec.reason
         verdict = rec.update(t, clear)
-        if verdict == RESUME:
-            self._reacquire(probe=kind == RESET, why=reason)
+        if verdict == RESUME:  # a moved camera moved no robot: its estimate goes on
+            self._reacquire(probe=kind == RESET, why=reason, keep_estimate=kind == MOVED)
             return ""
-        if rec.fault:
-            self.stop_reason = self.stop_reason or rec.fault
+        if rec.fault:  # the wait outlasted its bound: the step decides the stop that ends
+            self.stop_reason = self.stop_reason or rec.fault  # the run (its phase "stop")
+            return ""
         return f"waiting ({kind}): {reason}"
 
-    def _reacquire(self, probe: bool, why: str) -> None:
-        """Back the safe way: the estimator started afresh from sightings it gates, the
-        acquisition again (with a probe move where the heading may have changed), the
-        controller's state anew but for what it learnt of the object and the wheels."""
+    def _reacquire(self, probe: bool, why: str, keep_estimate: bool = False) -> None:
+        """Back the safe way: the estimator started afresh from sightings it gates (or, with
+        keep_estimate, going on: its gate keeps the robot where it stood), the acquisition
+        again (with a probe move where the heading may have changed), the controller's state
+        anew but for what it learnt of the object and the wheels."""
         assert self.controller is not None
         old = self.controller
-        self.estimator.forget()
+        if not keep_estimate:
+            self.estimator.forget()
         self.acquisition = Acquisition(self.cfg.acquire,
                                        facing_away=None if probe else old.facing_away)
         c = Controller(old.target_m, self.control)
@@ -757,17 +765,21 @@ class Servo:
         """A frame of the re-reference after the camera moved: its whole map with the
         robot's region left out; with reference_frames of them, the floor, reference map and
         target again (True), or not yet / not possible (False: tried again, REREFERENCE_TRIES
-        times in all)."""
+        times in all). Only frames where the estimator's gate admitted the marker count: the
+        robot's region is left out where it stands now (the picture moved: where it was seen
+        before the knock is rows off), and it is the robot the estimator followed (a pitch
+        changes neither the marker's disparity nor its column)."""
+        if pair is None or self.estimator.state is None:
+            return False
         disp = compute_disparity(frame.left, frame.right, self.params)
-        robot_at = pair or self.last_pair
-        if robot_at is not None:
-            x0, y0, x1, y1 = self._robot_region(robot_at, frame.left.shape)
-            disp[y0:y1, x0:x1] = np.nan
+        box = self._robot_region(pair, frame.left.shape)
+        x0, y0, x1, y1 = box
+        disp[y0:y1, x0:x1] = np.nan
         self._reref.append(disp)
         if len(self._reref) < self.cfg.reference_frames:
             return False
         maps, self._reref = self._reref, []
-        why = self._rereference(maps, frame)
+        why = self._rereference(maps, frame, box)
         if why:
             self._reref_fails += 1
             if self._reref_fails >= REREFERENCE_TRIES:
@@ -776,13 +788,20 @@ class Servo:
                 self.notes.append(f"re-referencing failed: {why}; trying again")
         return not why
 
-    def _rereference(self, maps: list[np.ndarray], frame: StereoFrame) -> str:
-        """The reference again from maps (the robot's region NaN): "" when done, else why
-        not. The floor keeps its slope (rereference.py); the object must be found where it
-        was (the camera moved, not the object) and agree in both views."""
+    def _rereference(self, maps: list[np.ndarray], frame: StereoFrame,
+                     robot: tuple[int, int, int, int]) -> str:
+        """The reference again from maps (the robot's region, robot, NaN): "" when done, else
+        why not. A pitch moves the whole picture by the rows phase correlation measures and
+        changes no depth: the robot's region is filled from the old reference moved by them,
+        the floor refitted with its slope, and what is found must be the old reference moved
+        by them (rereference.rereference_fault: the floor's horizon, the target's place,
+        disparity and two views). Heights above the floor (the lane, the fixed objects) are
+        then measured from the moved horizon."""
         assert self.tracker is not None and self.controller is not None
+        assert self.reference_map is not None and self._reference_image is not None
         old = self.tracker.target
-        reference = median_map(maps)
+        dy = vertical_shift_px(self._reference_image, frame.left)
+        reference = fill_hidden(median_map(maps), self.reference_map, robot, dy)
         floor = refit_floor(reference, self.floor) if self.floor else fit_floor(reference)
         if floor is None:
             return "no floor in the rows the robot leaves free"
@@ -790,13 +809,17 @@ class Servo:
             target = nearest_object(without_floor(reference, floor), self.tracker.min_area)
         except HostError as e:
             return str(e)
-        if abs(target.disparity - old.disparity) > max(1.0, 0.1 * old.disparity):
-            return (f"the nearest object is at {target.disparity:.1f} px, the target was at "
-                    f"{old.disparity:.1f} px")
         agree = views_agree(frame.left, frame.right, target.bbox, target.disparity)
-        if not agree >= 0.6:
-            return f"the target's region does not agree in both views ({agree:.2f})"
-        self.floor, self.reference_map = floor, reference
+        rows = target_shift_rows(self._reference_image, frame.left, old.bbox,
+                                 int(abs(dy)) + 4)
+        why = rereference_fault(self.floor, floor, dy, old, target, agree,
+                                moved_rows=self.cfg.moved_rows * self.geometry.focal_px,
+                                target_rows=rows)
+        if why:
+            return why
+        k, lane = self._lane_scale, self._lane_geometry
+        lane = dataclasses.replace(lane, cy=lane.cy + dy / k)  # the horizon moved
+        self.floor, self.reference_map, self._lane_geometry = floor, reference, lane
         self._reference_image = reference_image(frame.left)
         self._lane_reference = self._lane_map(reference)
         self.tracker = TargetTracker(target, self.tracker.min_area, self.cfg.tracker)
@@ -804,11 +827,14 @@ class Servo:
         self.controller.target_m = self.geometry.depth_m(target.disparity)
         self.controller.keep_out = self._extent(
             object_extent(without_floor(reference, floor), target))
-        self.controller.fixed = fixed_cells(reference, self.geometry, self.control.cell_m)
+        g = self.geometry
+        self.controller.fixed = fixed_cells(
+            reference, dataclasses.replace(g, cy=(lane.cy + 0.5) * k - 0.5),
+            self.control.cell_m)
         assert self._strips is not None
         self._strips.reset()
         self._remeasure_t = None
-        self.notes.append(f"re-referenced after the camera moved: target at "
+        self.notes.append(f"re-referenced after the camera moved {dy:+.1f} rows: target at "
                           f"{target.disparity:.2f} px")
         return ""
 

@@ -86,7 +86,9 @@ class Recovery:
 
     def begin(self, t: float, kind: str, reason: str) -> bool:
         """The condition `kind` (reason: in words) is met at t: wait it out (True), or the run
-        must end (False, fault set). A wait of the same kind already on goes on unchanged."""
+        must end (False, fault set). A wait of the same kind already on goes on unchanged; so
+        does a wait for a moved camera when anything but a reset begins (the robot stands in
+        either; the other condition is met again, if it still holds, on the new reference)."""
         if self.fault:
             return False
         if self.kind == kind:
@@ -99,6 +101,8 @@ class Recovery:
             self.fault = reason if bound.times == 0 else (
                 f"{reason} (the {_nth(n)} time in this run)")
             return False
+        if self.kind == MOVED and kind != RESET:  # nothing is judged on a reference the
+            return True  # camera left (a lane on the old floor line): re-referenced first
         if self.kind:  # another wait is on: it ends in this one (the stricter is kept)
             self.kind = ""
         self.kind, self.reason, self._since, self._clear_since = kind, reason, t, None

@@ -1,16 +1,30 @@
-"""The floor fitted again after the camera was pitched (a knock, a cable tug): a pure function.
+"""The reference made again after the camera was pitched (a knock, a cable tug), and its checks:
+pure functions.
 
 A pitch moves the horizon, not the floor's growth of disparity with the row (d = B (y - y_h) / h
 for a camera at height h: the slope B / h stays), so the new fit keeps the reference's slope and
 finds the offset that most low rows agree on. A free line fit (perception.fit_floor) on a
 pitched view can settle on the boxes that then fill more of the low rows.
+
+A pitch moves the whole picture by the same rows and changes no depth: everything the
+re-reference finds must be what the old reference showed, moved by the picture's measured shift
+(rereference_fault). The floor's horizon (y_h = -offset / slope) moves with the picture; the
+target is found where it was, shifted by those rows, at the disparity it had, and agrees in both
+views. Anything else (the target moved or taken away meanwhile, a look-alike at a depth near the
+target's elsewhere in the picture, a floor fitted on the wrong rows) is not a moved camera alone,
+and the robot stays stopped.
 """
 
 from __future__ import annotations
 
+import math
+from dataclasses import dataclass
+
+import cv2
 import numpy as np
 
-from host.servo.perception import Floor
+from host.servo.perception import Floor, Target
+from host.stereo.grey import to_grey
 
 
 def refit_floor(disp: np.ndarray, reference: Floor, min_rows: int = 10,
@@ -37,3 +51,123 @@ def refit_floor(disp: np.ndarray, reference: Floor, min_rows: int = 10,
     if agree.size < min_rows:
         return None
     return Floor(reference.slope, float(np.median(agree)))
+
+
+def horizon_row(floor: Floor) -> float:
+    """The row where the floor's disparity reaches zero (the horizon), px."""
+    return -floor.offset / floor.slope
+
+
+@dataclass(frozen=True)
+class RereferenceLimits:
+    """How far a re-reference may stray from the old reference moved by the picture's shift.
+
+    horizon_rows: the floor fit's offset is a median of rows' modes in 0.25 px bins (about 1
+    row at the default scene's 0.24 px a row) and the picture's shift a phase correlation
+    (sub-pixel); 2.5 rows leave room for both, a tenth of a degree of pitch less than
+    ServoConfig.moved_rows' smallest move reported. disparity: a pitch of 2 degrees changes the
+    depth of a point 0.3 m off the axis by 0.7 %; the target's measures scatter by 0.1-0.2 px;
+    a move of the target by 3 % (4.5 cm at 1.5 m) is a move, not the camera's. overlap: of the
+    narrower region, in both directions (nearest_object's region of one box varies between
+    28 and 89 px wide from one measure to the next, always over the same box)."""
+
+    horizon_rows: float = 2.5
+    slope_frac: float = 0.02
+    disparity_px: float = 0.5
+    disparity_frac: float = 0.03
+    overlap: float = 0.5
+    agreement: float = 0.6
+
+
+def _overlap(a0: float, a1: float, b0: float, b1: float) -> float:
+    """The overlap of intervals [a0, a1) and [b0, b1) as a share of the narrower."""
+    narrower = min(a1 - a0, b1 - b0)
+    return max(0.0, min(a1, b1) - max(a0, b0)) / narrower if narrower > 0 else 0.0
+
+
+def target_shift_rows(reference: np.ndarray, image: np.ndarray, box: tuple[int, int, int, int],
+                      max_rows: int, max_cols: int = 4, min_score: float = 0.25) -> float:
+    """How many rows (positive: down) the picture of the region box (x, y, w, h) of reference
+    (rig.reference_image: grey float32) moved in image: the best normalised correlation of the
+    region within max_rows up or down and max_cols across. NaN when the best scores below
+    min_score (the region's picture is not there: it was replaced, or something stands in
+    front of it) or the search leaves the picture. A pitch warps the picture a little and the
+    sensor's noise is new: a box's front knocked 1.8 degrees scored 0.37-0.49 at its shifted
+    place and under 0.1 elsewhere (dev seed 8's trial 45)."""
+    grey = to_grey(image).astype(np.float32)
+    h, w = grey.shape
+    x, y, bw, bh = box
+    y0, y1, x0, x1 = y - max_rows, y + bh + max_rows, x - max_cols, x + bw + max_cols
+    if bw < 8 or bh < 8 or y0 < 0 or x0 < 0 or y1 > h or x1 > w:
+        return math.nan
+    scores = cv2.matchTemplate(grey[y0:y1, x0:x1], reference[y:y + bh, x:x + bw],
+                               cv2.TM_CCOEFF_NORMED)
+    _, best, _, (_, row) = cv2.minMaxLoc(scores)
+    return float(row - max_rows) if best >= min_score else math.nan
+
+
+def rereference_fault(old_floor: Floor | None, floor: Floor, shift_rows: float, old: Target,
+                      new: Target, agreement: float, moved_rows: float = 0.0,
+                      target_rows: float | None = None,
+                      limits: RereferenceLimits = RereferenceLimits()) -> str:
+    """Why a re-reference cannot be trusted ("" when it can): what it found (floor, the
+    nearest object new, how well new's two views agree) against the old reference (old_floor,
+    the target old) moved by the picture's measured vertical shift (shift_rows, positive: down;
+    rig.vertical_shift_px). Checked: the picture moved at least moved_rows (the least move
+    the servo calls a moved camera: less, and what moved the floor's rows was put down over
+    them, a large box near the camera, which the phase correlation may read as a shift for a
+    moment), the floor's slope kept, its horizon moved by the picture's shift, the target
+    where the old one was (its region shifted by those rows overlapping the old by `overlap`
+    across and down; and, target_rows given, its picture moved by the picture's shift:
+    target_shift_rows, NaN when not found), at its disparity, and agreeing in both views."""
+    lim = limits
+    if abs(shift_rows) < moved_rows:
+        return (f"the picture did not move ({shift_rows:+.1f} rows): something stands over "
+                f"the floor's rows, the camera did not move")
+    if old_floor is not None:
+        if abs(floor.slope - old_floor.slope) > lim.slope_frac * abs(old_floor.slope):
+            return (f"the floor's slope changed from {old_floor.slope:.3f} to "
+                    f"{floor.slope:.3f} px a row")
+        moved = horizon_row(floor) - horizon_row(old_floor)
+        if not abs(moved - shift_rows) <= lim.horizon_rows:
+            return (f"the floor's horizon moved {moved:+.1f} rows where the picture moved "
+                    f"{shift_rows:+.1f}")
+    if target_rows is not None and not abs(target_rows - shift_rows) <= lim.horizon_rows:
+        return (f"the target's picture moved {target_rows:+.0f} rows where the picture moved "
+                f"{shift_rows:+.1f}" if math.isfinite(target_rows) else
+                "the target's picture is not where the picture's shift puts it")
+    tol = max(lim.disparity_px, lim.disparity_frac * old.disparity)
+    if not abs(new.disparity - old.disparity) <= tol:
+        return (f"the nearest object is at {new.disparity:.2f} px, the target was at "
+                f"{old.disparity:.2f} px")
+    ox, oy, ow, oh = old.bbox
+    nx, ny, nw, nh = new.bbox
+    across = _overlap(ox, ox + ow, nx, nx + nw)
+    down = _overlap(oy + shift_rows, oy + oh + shift_rows, ny, ny + nh)
+    if across < lim.overlap or down < lim.overlap:
+        return (f"the nearest object is not where the target was: ({nx}, {ny}) {nw}x{nh} px "
+                f"for ({ox}, {oy + shift_rows:.0f}) {ow}x{oh}")
+    if not agreement >= lim.agreement:
+        shown = "no texture" if math.isnan(agreement) else f"{agreement:.2f}"
+        return f"the target's region does not agree in both views ({shown})"
+    return ""
+
+
+def fill_hidden(new: np.ndarray, old: np.ndarray, box: tuple[int, int, int, int],
+                shift_rows: float) -> np.ndarray:
+    """The new reference map with the robot's region (box: x0, y0, x1, y1), where the robot
+    hid the scene, taken from the old reference moved by the picture's shift (a pitch moves
+    every pixel's row and keeps its disparity); what the old one did not show stays NaN."""
+    out = new.copy()
+    h = new.shape[0]
+    x0, y0, x1, y1 = box
+    dy = int(round(shift_rows))
+    ys = np.arange(y0, y1)
+    src = ys - dy
+    ok = (src >= 0) & (src < h)
+    region = out[ys[ok], x0:x1]
+    moved = old[src[ok], x0:x1]
+    hole = ~np.isfinite(region)
+    region[hole] = moved[hole]
+    out[ys[ok], x0:x1] = region
+    return out

@@ -75,17 +75,15 @@ class TargetTracker:
         if found is not None and overlap:
             if not agreement(found) >= self.cfg.still_there:
                 return old  # its two views disagree there: a spoilt map (flicker), not it
-            self._doubt = (0, "")
-            self.successor.reset()
-            self.history.append(found.disparity)
-            del self.history[:-self.cfg.history]
-            median = float(np.median(self.history))
-            self.target = Target(median, found.area, found.bbox, found.spread)
-            return self.target
+            return self.update_found(found)
         # gone means seen through: most of the object's area now shows what lies behind it; a
         # region hidden by something nearer (or masked as the robot) is not gone
         behind = int(np.count_nonzero(there < old.disparity - max(1.0, 0.1 * old.disparity)))
         if behind >= old.area // 2 and not agreement(old) >= self.cfg.still_there:
+            moved = self._moved_back(disp, agreement)
+            if moved is not None:  # the target moved farther, where it was: follow it,
+                self.history = [moved.disparity] * (self.cfg.history - 1)  # at its new depth
+                return self.update_found(moved)
             n = self._doubt[0] + 1 if self._doubt[1] == "vanished" else 1
             self._doubt = (n, "vanished")
             # the next object is looked for from the first doubt on
@@ -103,6 +101,37 @@ class TargetTracker:
         self.history = [found.disparity] * (self.cfg.history - 1)
         self.retargeted = True
         return found
+
+    def update_found(self, found: Target) -> Target:
+        """The target found again (moved or not): its disparity the median of the last
+        `history` measures."""
+        self._doubt = (0, "")
+        self.successor.reset()
+        self.history.append(found.disparity)
+        del self.history[:-self.cfg.history]
+        median = float(np.median(self.history))
+        self.target = Target(median, found.area, found.bbox, found.spread)
+        return self.target
+
+    def _moved_back(self, disp: np.ndarray, agreement: Callable[[Target], float]
+                    ) -> Target | None:
+        """The target moved farther (toward a robot behind it, say) and still stands in its
+        columns: the nearest object within them, farther by less than same_depth and agreeing
+        in both views; None if there is none. Something nearer elsewhere (another robot beside
+        the lane) must not become the target's successor while the target is still there."""
+        old = self.target
+        bx, _, bw, _ = old.bbox
+        cols = np.full_like(disp, np.nan)
+        cols[:, bx:bx + bw] = disp[:, bx:bx + bw]
+        try:
+            here = nearest_object(cols, self.min_area, near=old.disparity)
+        except HostError:
+            return None
+        x0, x1 = here.bbox[0], here.bbox[0] + here.bbox[2]
+        if not (old.disparity * (1 - self.cfg.same_depth) <= here.disparity < old.disparity
+                and (x0 > bx or x1 < bx + bw)):  # an edge of its own: not the wall seen
+            return None  # through the columns, filling them edge to edge
+        return here if agreement(here) >= self.cfg.still_there else None
 
     def _vouch(self, found: Target | None, agreement: Callable[[Target], float],
                width: int) -> Target | None:

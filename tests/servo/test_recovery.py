@@ -102,3 +102,16 @@ def test_the_floor_refitted_after_a_pitch_keeps_its_slope_and_finds_the_new_offs
 def test_no_floor_to_refit_where_the_low_rows_show_none():
     disp = np.full((240, 320), np.nan, np.float32)
     assert refit_floor(disp, Floor(0.24, -28.5)) is None
+
+
+def test_a_lane_met_while_the_camera_moved_does_not_end_the_wait_for_the_re_reference():
+    """The moved camera's wait goes on when an object in the lane is met in the same frame
+    (seen on the old floor line): before, the lane wait replaced it, the next re-measure found
+    the camera moved again, and the third time ended the run. A reset still replaces it."""
+    rec = Recovery(dict(BOUNDS))
+    assert rec.begin(1.0, MOVED, "the camera moved")
+    assert rec.begin(1.0, LANE, "an object in the lane")
+    assert rec.kind == MOVED and rec.reason == "the camera moved"
+    assert rec.update(1.1, False) == WAIT
+    assert rec.begin(1.2, RESET, "the board reset")
+    assert rec.kind == RESET
