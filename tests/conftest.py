@@ -97,6 +97,8 @@ SLOW_FILES = {
 # the fast tier: their first 300 trials missed two of the three mutants they kill
 # (motor-output-outside-the-lock, torn-32-bit-clock-read), so only whole sweeps are a check.
 SLOW_TESTS = {
+    "tests/servo/test_progress.py::test_the_servo_names_a_hold_it_cannot_keep_instead_of_running_out_of_time":
+        "a closed-loop run of 30 s",
     "tests/firmware/test_races.py::test_a_link_loss_cut_is_never_undone_or_lost_wherever_the_tick_lands":
         "an 1800-trial sweep in simavr",
     "tests/firmware/test_races.py::test_the_clock_read_at_a_carry_is_never_torn_wherever_the_tick_lands":
