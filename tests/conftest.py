@@ -73,6 +73,7 @@ SLOW_FILES = {
     "tests/servo/test_lane.py": "closed-loop runs with a box put in the lane",
     "tests/servo/test_fixed_objects.py": "closed-loop runs past a box and at the view's edge",
     "tests/servo/test_cut_marker.py": "closed-loop runs with the card behind the object's edge",
+    "tests/servo/test_acquire_freeze.py": "closed-loop runs with a sensor frozen in the probe",
     "tests/servo/test_range.py": "closed-loop runs from near and far",
     "tests/servo/test_timing_and_target.py": "closed-loop runs with a moved target",
     "tests/servo/test_servo_cli.py": "simulated host servo runs",

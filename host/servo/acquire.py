@@ -86,6 +86,17 @@ class Acquisition:
             return self._probe(t, position, noise_m)
         return Order(0, 0, DONE)
 
+    def interrupted(self, t: float) -> None:
+        """A frame at t not fit to use (stale, a sensor frozen): what the measure or the probe
+        saw so far is dropped and the phase begins again at the next usable frame (the robot
+        stands meanwhile). A probe timed across a frozen sensor would find that the marker did
+        not move, and leave the true marker out as a look-alike."""
+        if self.phase in (MEASURE, PROBE):
+            if self.phase == MEASURE:
+                self.disparities.clear()
+            self._track.clear()
+            self._t0 = None  # the phase's clock starts again at the next usable frame
+
     def _begin(self, phase: str, t: float) -> None:
         self.phase, self._t0 = phase, t
 

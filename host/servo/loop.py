@@ -687,7 +687,8 @@ class Servo:
         if self.stop_reason:  # read once: a STOP requested meanwhile acts next frame
             return Command(0, 0, "stop", None)
         if not self.acquisition.done:
-            if invalid:
+            if invalid:  # the measure or probe begins again after it (acquire.py)
+                self.acquisition.interrupted(t)
                 return Command(0, 0, "stale", None)
             cmd = self._acquire(t, position, d)
             return Command(0, 0, "stop", None) if self.stop_reason else cmd
