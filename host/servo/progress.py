@@ -3,8 +3,9 @@ there is a fault the servo names itself, not something left to an outer time lim
 state machine, one call a frame).
 
 Progress is either of:
-  - a step: the depth error's magnitude below its least so far by step_m (the least is
-    forgotten when the target's depth moves by step_m: a new goal);
+  - a step: the depth error's magnitude below its least so far by step_m, or by half the
+    least when that is smaller (not below min_step_m: noise); the least is forgotten when the
+    target's depth moves by step_m (a new goal);
   - a steady hold: holding hold_s without a break (each frame of it counts).
 No progress for stall_s while the servo commands (waits that recovery.py bounds do not count:
 the robot stands for a reason with its own limit) ends the run: the robot that oscillates
@@ -22,9 +23,10 @@ NO_PROGRESS = "no progress toward the target"
 
 @dataclass(frozen=True)
 class ProgressConfig:
-    stall_s: float = 15.0  # no progress this long ends the run: well past a turn (at most 8 s)
-    # and its search, and a third of the trials' 45 s limit
-    step_m: float = 0.02  # twice the default tolerance: noise does not make a step
+    stall_s: float = 20.0  # no progress this long ends the run: a turn (at most 8 s), its
+    # search and a turn back (dev seed 104's trial 1 needed 15 s after the target moved)
+    step_m: float = 0.02  # twice the default tolerance
+    min_step_m: float = 0.005  # below this a step may be the depth noise at the hold
     hold_s: float = 1.0  # a hold this long without a break is where the servo means to be
 
 
@@ -60,8 +62,8 @@ class Progress:
                 self._progress(t)
         else:
             self._hold_t0 = None
-        if error_m is not None and math.isfinite(error_m) and abs(error_m) < \
-                self.best - cfg.step_m:
+        step = min(cfg.step_m, max(cfg.min_step_m, self.best / 2))
+        if error_m is not None and math.isfinite(error_m) and abs(error_m) < self.best - step:
             self.best = abs(error_m)
             self._progress(t)
         if phase not in self.last_phases:

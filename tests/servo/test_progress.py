@@ -63,7 +63,8 @@ def test_the_servo_names_a_hold_it_cannot_keep_instead_of_running_out_of_time() 
     """Closed loop (the constructed case of dev seed 102's trial 74): at the target the marker
     is unseen three frames in six (a card at the edge of what the search finds), so the servo
     holds only between gaps and never for the settle time. Before the progress check the run
-    went on to its limit (NOT_SETTLED); now the servo stops it with a named reason."""
+    went on to its limit (NOT_SETTLED, 44 s here as the trials' 45 s); now the servo stops it
+    with a named reason."""
     with simulation(1.6, seed=3) as sim:
         read, count = sim.source.read, [0]
 
@@ -84,7 +85,7 @@ def test_the_servo_names_a_hold_it_cannot_keep_instead_of_running_out_of_time() 
             return StereoFrame(left, right, f.t_left, f.t_right)
 
         sim.source.read = gappy
-        end = run_servo(sim.servo, Rules(settle_s=1.0, limit_s=40.0), sim.source.clock)
+        end = run_servo(sim.servo, Rules(settle_s=1.0, limit_s=44.0), sim.source.clock)
     assert count[0] > 30, "the robot never reached the target: the case was not built"
     assert end.how == STOPPED and end.reason.startswith(NO_PROGRESS), end
     assert end.how != NOT_SETTLED
