@@ -88,6 +88,8 @@ class ControlConfig:
     min_gap_s: float = 0.3  # the card is edge-on at least this long in a turn (a flicker is not)
     search_duty: int = 300  # spin to find the marker again when it is lost after a turn
     search_s: float = 8.0
+    steady_frames: int = 10  # the card seen this many frames running after a turn: found (a
+    # glimpse of it, the turn ended short, does not end the search)
     lost_frames: int = 3
 
 
@@ -139,6 +141,7 @@ class Controller:
         self.history: list[Observation] = []  # valid observations since the last turn
         self._turn: dict[str, Any] | None = None
         self._search_until: float | None = None
+        self._seen_run = 0  # frames the card has been seen running
         self._reversing = False  # this leg is reversed: a turn would sweep into the object
 
     # ---------------------------------------------------------------------- estimates
@@ -274,6 +277,7 @@ class Controller:
             return self._turning(obs)
         if obs.depth_m is None:
             self.missing += 1
+            self._seen_run = 0
             if self.phase in (HOLD, WAIT, LOST) and self._pushed(obs.t, seen=False):
                 self.fault = PUSHED
                 return self._stop(BLOCKED, None)
@@ -291,7 +295,9 @@ class Controller:
             return self._stop(LOST, None)
         self.missing = 0
         self.seen = True
-        self._search_until = None
+        self._seen_run += 1
+        if self._seen_run >= self.cfg.steady_frames:
+            self._search_until = None
         if self.lateral_ref is None:
             self.lateral_ref = obs.lateral_m
         self.history.append(obs)
@@ -368,6 +374,7 @@ class Controller:
     # --------------------------------------------------------------------------- turn
 
     def _start_turn(self, obs: Observation, e: float) -> Command:
+        self._seen_run = 0  # the card seen after the turn counts afresh
         self._turn = {"t0": obs.t, "lost_t": None, "lost_aspect": 1.0, "end": None,
                       "last_seen": (obs.t, obs.aspect)}
         return self._spin(e)
