@@ -56,3 +56,14 @@ def test_a_sensor_frozen_during_the_probe_does_not_make_the_marker_a_look_alike(
         assert any(r.phase == "probe" for r in servo.rows)
         assert not any("did not move with the robot" in n for n in servo.notes), servo.notes
         assert servo.outcome() == ("held", ""), (servo.outcome(), servo.notes)
+
+
+def test_a_marker_gone_before_the_measure_is_done_is_found_again() -> None:
+    """Seen for two frames at the end of a turn (edge-on), then not: the measure does not wait
+    for ever (dev seed 104's trial 96 stood 17 s in it) but finds the card again, spinning."""
+    acq = Acquisition(AcquireConfig())
+    acq.update(0.0, (1.9, 0.0), 13.0)
+    acq.update(0.033, (1.9, 0.0), 13.0)
+    assert acq.phase == MEASURE
+    orders = [acq.update(0.033 * i, None, None) for i in range(2, 150)]
+    assert any(o.phase == "find" and o.left == -o.right != 0 for o in orders)
