@@ -76,6 +76,7 @@ SLOW_FILES = {
     "tests/servo/test_lane.py": "closed-loop runs with a box put in the lane",
     "tests/servo/test_fixed_objects.py": "closed-loop runs past a box and at the view's edge",
     "tests/servo/test_cut_marker.py": "closed-loop runs with the card behind the object's edge",
+    "tests/servo/test_acquire_freeze.py": "closed-loop runs with a sensor frozen in the probe",
     "tests/servo/test_range.py": "closed-loop runs from near and far",
     "tests/servo/test_timing_and_target.py": "closed-loop runs with a moved target",
     "tests/servo/test_servo_cli.py": "simulated host servo runs",
@@ -100,6 +101,8 @@ SLOW_FILES = {
 # the fast tier: their first 300 trials missed two of the three mutants they kill
 # (motor-output-outside-the-lock, torn-32-bit-clock-read), so only whole sweeps are a check.
 SLOW_TESTS = {
+    "tests/servo/test_progress.py::test_the_servo_names_a_hold_it_cannot_keep_instead_of_running_out_of_time":
+        "a closed-loop run of 30 s",
     "tests/firmware/test_races.py::test_a_link_loss_cut_is_never_undone_or_lost_wherever_the_tick_lands":
         "an 1800-trial sweep in simavr",
     "tests/firmware/test_races.py::test_the_clock_read_at_a_carry_is_never_torn_wherever_the_tick_lands":

@@ -4,7 +4,8 @@ way the robot faces by what a short probe move does (a pure state machine, one c
     find     the marker not seen yet: stand find_wait_s, then spin in place (search_duty) until
              it is seen, for at most find_s (a robot started at 60 or 90 degrees shows its card
              edge-on)
-    measure  standing, noise_frames sightings of its disparity (their spread is the noise)
+    measure  standing, noise_frames sightings of its disparity (their spread is the noise);
+             the marker unseen find_wait_s before they are in: find again
     probe    both wheels at probe_duty (raised by probe_step every probe_step_s), forward or
              backward (direction: the way the robot must go if it faces away), until
              the marker has moved probe_m (and three times its noise, the median of the last
@@ -62,6 +63,7 @@ class Acquisition:
         self._t0: float | None = None  # when the phase began
         self._track: list[tuple[float, float, float]] = []  # (t, z, x) in the probe
         self.direction = 1  # the probe's: +1 forward, -1 backward (set by the servo)
+        self._seen_t = -math.inf  # the last sighting's time
 
     @property
     def done(self) -> bool:
@@ -78,13 +80,31 @@ class Acquisition:
             return self._find(t, position is not None)
         if self.phase == MEASURE:
             if disparity is not None:
+                self._seen_t = t
                 self.disparities.append(disparity)
                 if len(self.disparities) >= self.cfg.noise_frames:
                     self._begin(PROBE if self.probes else DONE, t)
+            elif t - max(t if self._t0 is None else self._t0, self._seen_t) > \
+                    self.cfg.find_wait_s:
+                # gone again before the measure was done (seen edge-on at the end of a turn,
+                # a glimpse): find it again, spinning if need be, rather than wait for ever
+                self.disparities.clear()
+                self._begin(FIND, t)
             return Order(0, 0, MEASURE)
         if self.phase == PROBE:
             return self._probe(t, position, noise_m)
         return Order(0, 0, DONE)
+
+    def interrupted(self, t: float) -> None:
+        """A frame at t not fit to use (stale, a sensor frozen): what the measure or the probe
+        saw so far is dropped and the phase begins again at the next usable frame (the robot
+        stands meanwhile). A probe timed across a frozen sensor would find that the marker did
+        not move, and leave the true marker out as a look-alike."""
+        if self.phase in (MEASURE, PROBE):
+            if self.phase == MEASURE:
+                self.disparities.clear()
+            self._track.clear()
+            self._t0 = None  # the phase's clock starts again at the next usable frame
 
     def _begin(self, phase: str, t: float) -> None:
         self.phase, self._t0 = phase, t

@@ -20,6 +20,9 @@ the turn rate actually achieved; the spin goes on for the remaining angle at tha
 absence shorter than min_gap_s is a missed detection, not the card's back, and is forgotten).
 Then re-acquisition: driving waits for the marker; if the card is not seen after the turn (it
 never came back, or the turn ended with it edge-on), the robot spins slowly on to find it.
+Where a turn in place would sweep the body into the object (beside it, near its depth), the
+robot does not turn (nor stop): it drives that leg in reverse along its line, as mode
+"reverse" does, with every check of a drive.
 Lateral: the marker's position x = B (u - cx) / d is held on a lane: where it was first seen,
 unless that line passes the object (keep_out, the object's lateral extent at its depth, from the
 servo) closer than clearance_m, centre to side; then the lane moves to the nearer clear side.
@@ -85,6 +88,8 @@ class ControlConfig:
     min_gap_s: float = 0.3  # the card is edge-on at least this long in a turn (a flicker is not)
     search_duty: int = 300  # spin to find the marker again when it is lost after a turn
     search_s: float = 8.0
+    steady_frames: int = 10  # the card seen this many frames running after a turn: found (a
+    # glimpse of it, the turn ended short, does not end the search)
     lost_frames: int = 3
 
 
@@ -136,6 +141,8 @@ class Controller:
         self.history: list[Observation] = []  # valid observations since the last turn
         self._turn: dict[str, Any] | None = None
         self._search_until: float | None = None
+        self._seen_run = 0  # frames the card has been seen running
+        self._reversing = False  # this leg is reversed: a turn would sweep into the object
 
     # ---------------------------------------------------------------------- estimates
 
@@ -270,6 +277,7 @@ class Controller:
             return self._turning(obs)
         if obs.depth_m is None:
             self.missing += 1
+            self._seen_run = 0
             if self.phase in (HOLD, WAIT, LOST) and self._pushed(obs.t, seen=False):
                 self.fault = PUSHED
                 return self._stop(BLOCKED, None)
@@ -287,7 +295,9 @@ class Controller:
             return self._stop(LOST, None)
         self.missing = 0
         self.seen = True
-        self._search_until = None
+        self._seen_run += 1
+        if self._seen_run >= self.cfg.steady_frames:
+            self._search_until = None
         if self.lateral_ref is None:
             self.lateral_ref = obs.lateral_m
         self.history.append(obs)
@@ -321,11 +331,14 @@ class Controller:
         if not moving_in and abs(e) <= 0.25 * cfg.tolerance_m:
             return self._stop(HOLD, e)
         forward = away == self.facing_away
-        if not forward and cfg.mode == "turn":
-            if self.sweeps(z, obs.lateral_m):
-                self.fault = TURN_BLOCKED
-                return self._stop(BLOCKED, e)
-            return self._start_turn(obs, e)
+        if forward:
+            self._reversing = False
+        elif cfg.mode == "turn" and not self._reversing:
+            if not self.sweeps(z, obs.lateral_m):
+                return self._start_turn(obs, e)
+            # a turn here would sweep the body into the object: this leg is driven in
+            # reverse instead, along the robot's line (the body checks as for any drive)
+            self._reversing = True
         creeping = abs(e) <= cfg.creep_m
         if creeping and self.phase == CREEP and abs(zdot) < 0.004:
             self.floor = min(cfg.max_duty // 2 + 100, self.floor + cfg.creep_step)
@@ -361,6 +374,7 @@ class Controller:
     # --------------------------------------------------------------------------- turn
 
     def _start_turn(self, obs: Observation, e: float) -> Command:
+        self._seen_run = 0  # the card seen after the turn counts afresh
         self._turn = {"t0": obs.t, "lost_t": None, "lost_aspect": 1.0, "end": None,
                       "last_seen": (obs.t, obs.aspect)}
         return self._spin(e)

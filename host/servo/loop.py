@@ -66,6 +66,7 @@ from host.servo.perception import (
     stopping_distance_m,
     without_floor,
 )
+from host.servo.progress import Progress, ProgressConfig
 from host.servo.recovery import LANE, MOVED, RESET, RESUME, TARGET, Recovery, servo_bounds
 from host.servo.recovery import OUTSIDE as OUTSIDE_KIND
 from host.servo.rereference import (
@@ -145,6 +146,7 @@ class ServoConfig:
     estimator: EstimatorConfig = field(default_factory=EstimatorConfig)
     acquire: AcquireConfig = field(default_factory=AcquireConfig)
     tracker: TrackerConfig = field(default_factory=TrackerConfig)
+    progress: ProgressConfig = field(default_factory=ProgressConfig)
 
 
 @dataclass
@@ -231,6 +233,7 @@ class Servo:
         self._reref: list[np.ndarray] = []  # the re-reference's maps so far (robot left out)
         self._reref_fails = 0  # re-references that failed, in this wait
         self._targets_before: list[Target] = []  # the targets a nearer object replaced
+        self.progress = Progress(self.cfg.progress)  # no progress for long: the run ends
 
     @property
     def strips(self) -> StripMap | None:
@@ -655,6 +658,12 @@ class Servo:
                 self._reacquire(probe=True, why="the marker was seen only outside the gate")
             cmd = self._decide(t, pair, position, seen.disparity, invalid)
             cmd, invalid = self._watch_lane(frame, t, cmd, invalid)
+        stalled = self.progress.update(t, cmd.phase, cmd.error_m, self.target_m,
+                                       waiting=bool(waiting) or self.recovery.active)
+        if stalled and not self.stop_reason:  # STOP now: the run ends with this step
+            self.stop_reason = stalled
+            self.notes.append(f"{stalled}: {self.progress.detail()}")
+            cmd = Command(0, 0, "stop", cmd.error_m)
         t_send = time.perf_counter()
         self._send(cmd, t)
         rtt_ms = (time.perf_counter() - t_send) * 1000
@@ -683,7 +692,8 @@ class Servo:
         if self.stop_reason:  # read once: a STOP requested meanwhile acts next frame
             return Command(0, 0, "stop", None)
         if not self.acquisition.done:
-            if invalid:
+            if invalid:  # the measure or probe begins again after it (acquire.py)
+                self.acquisition.interrupted(t)
                 return Command(0, 0, "stale", None)
             cmd = self._acquire(t, position, d)
             return Command(0, 0, "stop", None) if self.stop_reason else cmd

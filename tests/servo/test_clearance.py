@@ -13,7 +13,6 @@ import numpy as np
 from host.servo.controller import (
     LINE_BLOCKED,
     PUSHED,
-    TURN_BLOCKED,
     ControlConfig,
     Controller,
     Observation,
@@ -161,16 +160,39 @@ def test_the_lane_keeps_clear_of_a_fixed_object_between_the_robot_and_the_target
 def test_a_turn_in_place_that_would_sweep_the_body_into_the_object_is_not_started() -> None:
     """Beside the object, 3 cm past its depth, the body (8 cm each side of its line) is 3 cm
     clear of the object's side but a turn in place sweeps half its diagonal (11.5 cm): the
-    robot stops with the reason instead of turning (seed 7 trial 843 and a seed-4 trial ended
-    with the line beside the box's edge). With room for the sweep it turns."""
+    robot does not turn there (seed 7 trial 843 and a seed-4 trial ended with the line beside
+    the box's edge) but backs in along its line. With room for the sweep it turns."""
     side = BOX[1] + ControlConfig().half_width_m + 0.03
     ctl = Controller(1.2, ControlConfig())
     ctl.keep_out = BOX
     cmd = ctl.update(Observation(0.0, 1.23, side))
-    assert cmd.is_stop and ctl.fault == TURN_BLOCKED
+    assert cmd.left < 0 and cmd.right < 0 and not ctl.fault, (cmd, ctl.fault)
     roomy = Controller(1.2, ControlConfig())
     roomy.keep_out = BOX
     assert roomy.update(Observation(0.0, 1.23, BOX[1] + 0.15)).phase == "turn"
+
+
+def test_where_a_turn_would_sweep_into_the_object_the_robot_reverses_to_its_hold() -> None:
+    """Driven in the plant: facing away, 6 cm past the object's depth and 3 cm clear of its
+    side, the robot must come back. A turn would sweep its body into the box (the run used to
+    stop there: "turning here would sweep ...", 16 of seed 9's 1000 trials); it reverses
+    along its line instead and holds at the object's depth, never turning, the body clear."""
+    side = BOX[1] + ControlConfig().half_width_m + 0.03
+    ctl = Controller(1.2, ControlConfig())
+    ctl.keep_out = BOX
+    plant = Plant(1.26)
+    plant.x = side
+    gap, phases = math.inf, set()
+    while plant.t < 15 and not ctl.fault:
+        cmd = ctl.update(plant.observe())
+        phases.add(cmd.phase)
+        plant.run(33, (cmd.left, cmd.right))
+        gap = min(gap, plant.x - ctl.cfg.half_width_m - BOX[1])
+        if ctl.phase == "hold" and plant.t > 3 and abs(plant.vl) + abs(plant.vr) < 1e-4:
+            break
+    assert not ctl.fault and ctl.phase == "hold", (ctl.fault, ctl.phase)
+    assert abs(plant.z - 1.2) <= 0.015 and "turn" not in phases
+    assert gap > 0.015 and math.cos(plant.theta) > 0.9  # steered to its lane, not turned
 
 
 def test_a_robot_pushed_toward_the_object_while_its_card_is_unseen_stops_the_run() -> None:
@@ -204,4 +226,5 @@ def test_a_look_alike_where_the_robot_stands_does_not_block_its_turn() -> None:
     beside = Controller(1.2, ControlConfig())
     beside.keep_out = BOX
     beside.fixed = np.array([[1.49, 0.11]])
-    assert beside.update(Observation(0.0, 1.5, 0.0)).is_stop and beside.fault == TURN_BLOCKED
+    cmd = beside.update(Observation(0.0, 1.5, 0.0))  # no turn: it reverses instead
+    assert cmd.phase == "drive" and cmd.left < 0 and cmd.right < 0 and not beside.fault

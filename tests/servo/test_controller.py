@@ -105,3 +105,27 @@ def test_a_flicker_of_the_card_does_not_end_the_turn() -> None:
         t += 0.1
         assert ctl.update(Observation(t, None)).phase == "turn"
     assert ctl.facing_away
+
+
+def test_a_glimpse_of_the_card_after_a_turn_does_not_end_the_search_for_it() -> None:
+    """The turn ends short of facing back (dev seed 104's trial 1: the target moved, the robot
+    turned, its card was seen for one frame and then not for 5 s: "marker lost"). One frame
+    of the card is a glimpse, not the card found: the robot spins on to find it (SEARCH)
+    rather than stand lost until the run ends."""
+    plant = Plant(1.2)
+    ctl = Controller(1.2, ControlConfig())
+    while plant.t < 2:  # holding, the card seen every frame
+        cmd = ctl.update(plant.observe())
+        plant.run(33, (cmd.left, cmd.right))
+    assert ctl.phase == "hold"
+    ctl.target_m = 0.9  # the target moved nearer: the robot must turn round
+    turned = False
+    while plant.t < 15 and not turned:
+        cmd = ctl.update(plant.observe())
+        plant.run(33, (cmd.left, cmd.right))
+        turned = ctl.facing_away is False and cmd.phase != "turn"
+    assert turned
+    t = plant.t
+    ctl.update(Observation(t, 1.5, 0.0, 0.8))  # one frame of the card
+    phases = [ctl.update(Observation(t + 0.033 * (i + 1), None)).phase for i in range(30)]
+    assert "search" in phases, phases
