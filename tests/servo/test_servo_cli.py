@@ -18,7 +18,7 @@ def run(*argv: str) -> subprocess.CompletedProcess[str]:
 
 def test_sim_run_writes_log_and_plot(tmp_path: Path) -> None:
     log, fig = tmp_path / "run.csv", tmp_path / "run.png"
-    r = run("--sim", "--start-depth", "0.9", "--border", "clip", "--num-disp", "48",
+    r = run("--sim", "--start-depth", "0.9", "--border", "clip", "--num-disparities", "48",
             "--log", str(log), "--plot", str(fig))
     assert r.returncode == 0, r.stderr
     assert "target: nearest object at disparity" in r.stderr and "held at " in r.stderr
@@ -44,6 +44,6 @@ def test_missing_port_and_bad_camera_are_one_line_errors(tmp_path: Path) -> None
 def test_link_fault_options_reach_the_simulated_robot() -> None:
     """host servo --sim takes the emulator's link faults: a robot that goes silent ends the run
     with the link's error, not a hold."""
-    r = run("--sim", "--start-depth", "0.9", "--border", "clip", "--num-disp", "48",
+    r = run("--sim", "--start-depth", "0.9", "--border", "clip", "--num-disparities", "48",
             "--drop", "0.001", "--corrupt", "0.001", "--delay-ms", "5", "--silent-after", "1500")
     assert r.returncode != 0 and "did not answer" in r.stderr and "held at" not in r.stderr
