@@ -53,10 +53,12 @@ def _box_sums(img: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray]:
     return s, sq
 
 
-def _planes(image: np.ndarray, colour: bool) -> np.ndarray:
-    """uint8 (channels, rows, cols): BGR planes when colour is asked for and present, else grey."""
+def _planes(image: np.ndarray, colour: bool, view: bool = False) -> np.ndarray:
+    """uint8 (channels, rows, cols): BGR planes when colour is asked for and present, else grey;
+    view: the colour planes as a view of image (no copy, not contiguous)."""
     if colour and image.ndim == 3 and image.shape[2] >= 3 and image.dtype == np.uint8:
-        return np.ascontiguousarray(np.moveaxis(image[:, :, :3], 2, 0))
+        planes = np.moveaxis(image[:, :, :3], 2, 0)
+        return planes if view else np.ascontiguousarray(planes)
     return to_grey(image)[None]
 
 
@@ -126,6 +128,7 @@ def sgm_penalties(p: MatcherParams) -> tuple[int, int]:
 
 _VOLUMES = threading.local()
 KEEP_BYTES = 512 << 20  # sum volumes up to this size are kept for the next call of the same size
+KEEP_FOUR_BYTES = 64 << 20  # the same for the 4-path buffers (17 MiB at 1280x960 / 128)
 
 
 def _sgm_sums(shape: tuple[int, ...], nd: int, dtype: DTypeLike = np.uint16) -> np.ndarray:
@@ -153,7 +156,9 @@ def _sgm_sums(shape: tuple[int, ...], nd: int, dtype: DTypeLike = np.uint16) -> 
 def _four_path(shape: tuple[int, ...], nd: int, cmax: int, p2: int, rows_made: bool,
                stripes: int) -> sgm.FourPath:
     """The 4-path pass's buffers (sgm.FourPath), reused by the next call of the same size and
-    costs in this thread (so its blocks take no fresh pages: no page faults in steady state)."""
+    costs in this thread (so its blocks take no fresh pages: no page faults in steady state)
+    up to KEEP_FOUR_BYTES; larger ones are made per call, so they are not held through the
+    post-processing (at 2560x1920 / 256 they are 20 bytes a pixel)."""
     key = (shape[0], shape[1], nd, cmax, p2, rows_made, stripes)
     kept = getattr(_VOLUMES, "four", None)
     if kept is not None and kept[0] == key:
@@ -161,7 +166,8 @@ def _four_path(shape: tuple[int, ...], nd: int, cmax: int, p2: int, rows_made: b
         return got
     _VOLUMES.four = None
     out = sgm.FourPath.make(shape[0], shape[1], nd, cmax, p2, rows_made, stripes)
-    _VOLUMES.four = (key, out)
+    if sum(a.nbytes for a in out[1:]) <= KEEP_FOUR_BYTES:
+        _VOLUMES.four = (key, out)
     return out
 
 
@@ -172,16 +178,18 @@ def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
     """The own census + semi-global matcher (host/stereo/sgm.py): census of grey, the
     intensity term on colour (p.colour) or grey. The cost comes from
     the census rows inside the aggregation when it is census alone (window 1), else from a
-    cost volume (host/stereo/cost.py: the intensity term, the outside cost; the box sum)."""
-    gl, gr = to_grey(left), to_grey(right)
-    cl, cr = [sgm.census(cv2.copyMakeBorder(g, sgm.CENSUS_H, sgm.CENSUS_H, sgm.CENSUS_W,
-                                            sgm.CENSUS_W, cv2.BORDER_REPLICATE))
-              for g in (gl, gr)]
-    shape = gl.shape
-    del gl, gr  # 2 bytes a pixel less at the peak
+    cost volume (host/stereo/cost.py: the intensity term, the outside cost; the box sum).
+    Without a volume the passes make the census rows they need from the padded grey images
+    (16 bytes a pixel of census images not kept), and the LR check runs row by row (no right
+    map kept)."""
+    gl, gr = [cv2.copyMakeBorder(to_grey(v), sgm.CENSUS_H, sgm.CENSUS_H, sgm.CENSUS_W,
+                                 sgm.CENSUS_W, cv2.BORDER_REPLICATE) for v in (left, right)]
+    shape = left.shape[:2]
+    cl, cr = sgm.NO_CENSUS, sgm.NO_CENSUS
     vol, planes, rplanes, term = NO_VOLUME, sgm.NO_PLANES, sgm.NO_PLANES, sgm.census_term()
     if p.intensity_weight > 0 or p.outside_cost != sgm.CENSUS_BITS:
-        pl, pr = _planes(left, p.colour), _planes(right, p.colour)
+        # the left planes as a view of the image where it has colour (3 bytes a pixel less)
+        pl, pr = _planes(left, p.colour, view=True), _planes(right, p.colour)
         # the intensity term sees the right image with the left one's levels (per channel),
         # the table taken from the columns both cameras see (not the strip beside each edge)
         cut = min(p.min_disparity + p.num_disparities, shape[1] // 2)
@@ -197,15 +205,19 @@ def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
             planes, rplanes = pl, reversed_planes(pr, p.min_disparity, p.num_disparities)
         else:
             term = sgm.census_term()
+            cl, cr = sgm.census(gl), sgm.census(gr)
             vol = np.empty((*shape, p.num_disparities), dtype=np.uint16)
             vol = census_ad_volume(cl, cr, pl, pr, p.min_disparity, weight, p.intensity_cap,
                                    p.outside_cost, vol)
         del pr  # reversed (rplanes) or in the volume: 3 bytes a pixel less at the peak
     elif p.block_size > 1:
+        cl, cr = sgm.census(gl), sgm.census(gr)
         vol = np.empty((*shape, p.num_disparities), dtype=np.uint16)
         vol = sgm.hamming_volume(cl, cr, p.min_disparity, vol)
     if p.block_size > 1:
         vol = sgm.box_sum(vol, p.block_size)
+    if vol.shape[0]:
+        gl, gr = sgm.NO_GREY, sgm.NO_GREY  # the cost is in the volume
     p1, p2 = sgm_penalties(p)
     want_right = p.lr_check is not None
     # only the 8-path scheme keeps a sum volume; the 5- and 4-path passes decide each row as
@@ -218,18 +230,15 @@ def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
     four = _four_path(shape, p.num_disparities, sgm.largest_cost(vol, term), p2,
                       vol.shape[0] == 0, (1 if numba.get_num_threads() < 2 else 2)
                       if p.paths == 4 else 0)
-    crrev = sgm.reversed_right(cr, p.min_disparity, p.num_disparities)
-    del cr  # 8 bytes a pixel less at the peak
-    disp_l, disp_r = sgm.match(cl, crrev, vol, sums, p.min_disparity,
-                               np.uint16(p1), np.uint16(p2), p.paths,
-                               float(p.uniqueness_ratio), subpixel_fit(p), want_right, False,
-                               planes, rplanes, term, costs, four)
-    del cl, crrev, vol, planes, rplanes, costs
-    if p.lr_check is not None:  # want_right
-        # the right map has whole pixels: with a sub-pixel left map a tolerance under half a
-        # pixel (LR 0, the default) means the same winner, not no sub-pixel result at all
-        tol = float(p.lr_check)
-        disp_l = lr_consistency(disp_l, disp_r, max(tol, 0.5) if subpixel_fit(p) else tol)
+    crrev = sgm.reversed_right(cr, p.min_disparity, p.num_disparities) if cr.size else cr
+    del cr  # 8 bytes a pixel less at the peak (with a volume)
+    # the right map has whole pixels: with a sub-pixel left map a tolerance under half a
+    # pixel (LR 0, the default) means the same winner, not no sub-pixel result at all
+    tol = -1.0 if p.lr_check is None else float(p.lr_check)
+    lr = max(tol, 0.5) if subpixel_fit(p) and tol >= 0 else tol
+    disp_l, _ = sgm.match(cl, crrev, vol, sums, p.min_disparity, np.uint16(p1), np.uint16(p2),
+                          p.paths, float(p.uniqueness_ratio), subpixel_fit(p), want_right,
+                          False, planes, rplanes, term, costs, four, gl, gr, lr)
     if p.border == "invalid":
         # the census (and box) window of these pixels leaves the image
         ry, rx = sgm.CENSUS_H + p.block_size // 2, sgm.CENSUS_W + p.block_size // 2

@@ -11,16 +11,22 @@ from numba import njit
 def lr_consistency(disp_l: np.ndarray, disp_r: np.ndarray, tol: float) -> np.ndarray:
     """Invalidate (NaN) left disparities whose right match disagrees by more than tol px."""
     out = disp_l.copy()
-    h, w = disp_l.shape
-    for y in range(h):
-        for x in range(w):
-            d = disp_l[y, x]
-            if np.isnan(d):
-                continue
-            xr = int(np.floor(x - d + 0.5))
-            if xr < 0 or xr >= w or not abs(disp_r[y, xr] - d) <= tol:
-                out[y, x] = np.nan
+    for y in range(disp_l.shape[0]):
+        lr_row(out[y], disp_r[y], tol)
     return out
+
+
+@njit(cache=True)
+def lr_row(row_l: np.ndarray, row_r: np.ndarray, tol: float) -> None:
+    """lr_consistency on one row, in place (each pixel reads only itself and row_r)."""
+    w = row_l.shape[0]
+    for x in range(w):
+        d = row_l[x]
+        if np.isnan(d):
+            continue
+        xr = int(np.floor(x - d + 0.5))
+        if xr < 0 or xr >= w or not abs(row_r[xr] - d) <= tol:
+            row_l[x] = np.nan
 
 
 @njit(cache=True)

@@ -1,12 +1,14 @@
 """Own semi-global matcher: census Hamming cost, 4-, 5- or 8-path aggregation, WTA.
 
-Cost: a 9x7 census of the grey images (62 bits, replicated border) compared by Hamming
-distance (plus, with planes, the intensity term), made row by row where it is used, or a
-box-summed volume when block_size > 1. Aggregation (Hirschmueller's recurrence): 5 paths in one
-pass from the top (_down); 8 paths as two directions that each store their sums for half the
-image (_sweep); 4 paths, the defaults, in blocks of K rows from a stored row of the path from
-the bottom every K rows, with no volume (_vertical, _four). Path costs, sums and penalties are
-uint16 with the disparity axis innermost, so every per-disparity loop runs in 16-bit lanes.
+Cost: a 9x7 census of the grey images (62 bits, replicated border) compared by Hamming distance
+(plus, with planes, the intensity term), made row by row where it is used (the census rows too,
+from the padded grey images: no census image is kept), or a box-summed volume when
+block_size > 1. The LR check can run row by row as each row is decided (no right map kept).
+Aggregation (Hirschmueller's recurrence): 5 paths in one pass from the top (_down); 8 paths as two
+directions that each store their sums for half the image (_sweep); 4 paths, the defaults, in
+blocks of K rows from a stored row of the path from the bottom every K rows, with no volume
+(_vertical, _four). Path costs, sums and penalties are uint16 with the disparity axis
+innermost, so every per-disparity loop runs in 16-bit lanes.
 
 Candidate j is disparity dmin + j; the left pixel x matches right pixel x - d. A candidate
 whose right pixel falls outside the image costs the most a census can differ (CENSUS_BITS).
@@ -21,6 +23,7 @@ from numba import njit, prange, types
 from numba.extending import intrinsic
 
 from host.stereo import lanes as L
+from host.stereo.postprocess import lr_row
 from host.stereo.subpixel import FIT_NONE, fit_offset
 
 CENSUS_H = 3  # half height of the census window (7 rows)
@@ -35,36 +38,46 @@ def _popcount(typingctx, v):
     return types.uint64(types.uint64), codegen
 
 
+@njit(cache=True)
+def census_row(img, y, out, b):
+    """Row y of the 9x7 census of img into out (cols uint64): bit set where a neighbour is
+    darker than the centre, neighbour k (row by row, the centre left out) at bit 61 - k.
+
+    img is padded (CENSUS_H rows, CENSUS_W columns, replicated border), so the loop over x has
+    no clamping and runs in vector lanes. The bits are gathered eight neighbours to a byte in
+    b (8, cols) uint8 (four times the lanes of uint32: half the time of two uint32 rows), then
+    joined: byte g holds neighbours 8g .. 8g + 7 (the last one 56 .. 61).
+    """
+    w = out.shape[0]
+    b[:, :] = 0
+    centre = img[y + CENSUS_H, CENSUS_W:CENSUS_W + w]
+    k = 0
+    for dy in range(2 * CENSUS_H + 1):
+        nb_row = img[y + dy]
+        for dx in range(2 * CENSUS_W + 1):
+            if dy == CENSUS_H and dx == CENSUS_W:
+                continue
+            nb = nb_row[dx:dx + w]
+            acc = b[k // 8]
+            for x in range(w):
+                acc[x] = (acc[x] << np.uint8(1)) | np.uint8(nb[x] < centre[x])
+            k += 1
+    for x in range(w):
+        v = np.uint64(b[CENSUS_BITS // 8, x])
+        for g in range(CENSUS_BITS // 8):
+            v |= np.uint64(b[g, x]) << np.uint64(CENSUS_BITS - 8 - 8 * g)
+        out[x] = v
+
+
 @njit(cache=True, parallel=True)
 def census(img):
-    """9x7 census of a uint8 image: bit set where a neighbour is darker than the centre.
-
-    img is padded by the caller (CENSUS_H rows, CENSUS_W columns, replicated border), so the
-    loop over x has no clamping and runs in vector lanes. The first 31 neighbours' bits and the
-    last 31 are gathered in two uint32 rows (twice the lanes of uint64), then joined.
-    """
+    """9x7 census of a padded uint8 image (census_row at every row)."""
     hp, wp = img.shape
     h, w = hp - 2 * CENSUS_H, wp - 2 * CENSUS_W
-    half = CENSUS_BITS // 2
     out = np.empty((h, w), dtype=np.uint64)
     for y in prange(h):
-        hi = np.zeros(w, dtype=np.uint32)
-        lo = np.zeros(w, dtype=np.uint32)
-        centre = img[y + CENSUS_H, CENSUS_W:CENSUS_W + w]
-        k = 0
-        for dy in range(2 * CENSUS_H + 1):
-            nb_row = img[y + dy]
-            for dx in range(2 * CENSUS_W + 1):
-                if dy == CENSUS_H and dx == CENSUS_W:
-                    continue
-                nb = nb_row[dx:dx + w]
-                acc = hi if k < half else lo
-                for x in range(w):
-                    acc[x] = (acc[x] << np.uint32(1)) | np.uint32(nb[x] < centre[x])
-                k += 1
-        row = out[y]
-        for x in range(w):
-            row[x] = (np.uint64(hi[x]) << np.uint64(CENSUS_BITS - half)) | np.uint64(lo[x])
+        b = np.empty((8, w), dtype=np.uint8)
+        census_row(img, y, out[y], b)
     return out
 
 
@@ -118,10 +131,12 @@ PAD = np.uint16(0x3FFF)  # path cost beyond the disparity range: never the minim
 
 
 @njit(cache=True, fastmath=True, inline="always")
-def _cost_row(cl, crrev, vol, pl, prrev, term, y, dmin, crow):
+def _cost_row(cl, crrev, gl, gr, vol, pl, prrev, term, y, dmin, crow, cs):
     """Row y of the cost into crow (cols, nd): vol's row when a volume is given (box-summed
-    cost), else the census Hamming distances straight from the census images, plus (pl has
-    channels) the intensity term, with term[0] where the right pixel is outside the image.
+    cost), else the census Hamming distances of the census rows (cl[y], crrev[y], or where the
+    padded grey images gl, gr are given, made from them into the scratch cs: _census_rows),
+    plus (pl has channels) the intensity term, with term[0] where the right pixel is outside
+    the image.
 
     crrev holds each right census row reversed and zero-padded, so candidate j of left x reads
     it forwards from w - 1 - x + dmin: a contiguous load, one vector popcount per 8 lanes (the
@@ -130,11 +145,15 @@ def _cost_row(cl, crrev, vol, pl, prrev, term, y, dmin, crow):
     channels is (min(k, term[1]) * term[2] + term[3]) >> term[4] (integer_term: the same as
     cost.census_ad_volume's table at every k).
     """
-    w = cl.shape[1]
-    nd = crow.shape[1]
+    w, nd = crow.shape
     if vol.shape[0] > 0:
         crow[:, :] = vol[y]
         return
+    if gl.shape[0] > 0:
+        _census_rows(gl, gr, y, cs)
+        lrow, rrev = cs[0], cs[1]
+    else:
+        lrow, rrev = cl[y], crrev[y]
     far = np.uint16(term[0])
     ch = pl.shape[0]
     kcap = np.int32(term[1])
@@ -142,9 +161,9 @@ def _cost_row(cl, crrev, vol, pl, prrev, term, y, dmin, crow):
     tb = np.uint32(term[3])
     ts = np.uint32(term[4])
     for x in range(w):
-        a = cl[y, x]
+        a = lrow[x]
         base = w - 1 - x + dmin
-        r = crrev[y, base:base + nd]
+        r = rrev[base:base + nd]
         c = crow[x]
         if ch == 0:
             for j in range(nd):
@@ -170,6 +189,35 @@ def _cost_row(cl, crrev, vol, pl, prrev, term, y, dmin, crow):
                     (np.uint32(k) * ta + tb) >> ts)
         for j in range(max(0, x - dmin + 1), nd):
             c[j] = far
+
+
+@njit(cache=True)
+def _census_rows(gl, gr, y, cs):
+    """Census row y of the padded grey images into cs[0] (left) and cs[1] (right, reversed,
+    the zeros after it left as they are: the layout of reversed_right's row); cs[2], cs[3]:
+    scratch (a row, census_row's bytes)."""
+    lrow, rrev, tmp, b = cs
+    census_row(gl, y, lrow, b)
+    census_row(gr, y, tmp, b)
+    w = tmp.shape[0]
+    for x in range(w):
+        rrev[x] = tmp[w - 1 - x]
+
+
+@njit(cache=True)
+def _census_scratch(gl, dmin, nd):
+    """The rows _census_rows fills (empty where no grey images are given: census images)."""
+    w = gl.shape[1] - 2 * CENSUS_W if gl.shape[0] > 0 else 0
+    return (np.empty(w, dtype=np.uint64), np.zeros(w + dmin + nd if w else 0, dtype=np.uint64),
+            np.empty(w, dtype=np.uint64), np.empty((8, w), dtype=np.uint8))
+
+
+@njit(cache=True, inline="always")
+def _size(cl, gl):
+    """(rows, cols) of the images: the padded grey ones' less the padding, else the census's."""
+    if gl.shape[0] > 0:
+        return gl.shape[0] - 2 * CENSUS_H, gl.shape[1] - 2 * CENSUS_W
+    return cl.shape[0], cl.shape[1]
 
 
 @njit(cache=True, fastmath=True, inline="always")
@@ -278,7 +326,7 @@ def _first_min(s, m, idx, n):
 
 @njit(cache=True, fastmath=True)
 def _decide_row(tot, mins, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc, acc16,
-                sh, idx, jj, fb):
+                sh, idx, jj, fb, rr, lr):
     """Left (and right) disparities of row y from its total path costs tot (cols, nd) and
     their minima per pixel, mins.
 
@@ -291,7 +339,9 @@ def _decide_row(tot, mins, y, dmin, uniqueness, fit, want_right, disp_l, disp_r,
     pixel; its sub-pixel fit cost time and changed Cones and Teddy by under 0.1 %) and no
     uniqueness test.
     The left winners and their neighbours' costs go into fb (4, cols) float32 first, so the
-    sub-pixel fits run as one vector loop per row.
+    sub-pixel fits run as one vector loop per row. The right row goes into rr (cols, NaN from
+    cols - dmin on), then into disp_r[y] where disp_r has rows; with lr >= 0 the left row is
+    checked against it there (postprocess.lr_row), so no right map need be kept.
     """
     w, nd = tot.shape
     for x in range(w):
@@ -312,7 +362,18 @@ def _decide_row(tot, mins, y, dmin, uniqueness, fit, want_right, disp_l, disp_r,
     _fit_row(fb, disp_l[y], dmin, fit, w)
     if not want_right:
         return
-    row = disp_r[y]
+    _right_row(tot, dmin, acc, acc16, sh, idx, jj, rr)
+    if disp_r.shape[0] > 0:
+        disp_r[y] = rr
+    if lr >= 0.0:
+        lr_row(disp_l[y], rr, lr)
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _right_row(tot, dmin, acc, acc16, sh, idx, jj, row):
+    """The right view's whole-pixel disparities of a row (see _decide_row) into row[:cols -
+    dmin]."""
+    w, nd = tot.shape
     if sh > 0:
         acc16[:] = np.uint16(0xFFFF)
         for x in range(w):
@@ -346,9 +407,9 @@ def _fit_row(fb, out, dmin, fit, n):
 
 
 @njit(cache=True, fastmath=True)
-def _sweep(cl, crrev, vol, pl, prrev, term, S, C, P, M, crow, tot, forward, i0, i1, p1, p2,
+def _sweep(cl, crrev, gl, gr, vol, pl, prrev, term, S, C, P, M, crow, tot, forward, i0, i1, p1, p2,
            diagonals, finish, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc, acc16, sh,
-           keep):
+           keep, lr):
     """Rows i0 .. i1 - 1 (counted from the top when forward, else from the bottom) of one
     direction's paths: path 0 from behind in the row, 2 from the row before at the same x,
     and (diagonals) 1 and 3 from the row before at x - step and x + step.
@@ -360,14 +421,16 @@ def _sweep(cl, crrev, vol, pl, prrev, term, S, C, P, M, crow, tot, forward, i0, 
     nd) uint8, when not empty, takes each cost row made without finish, and a row with finish
     reads its cost from there (the other direction made it), so each row's cost is made once.
     """
-    h, w = cl.shape
+    h, w = _size(cl, gl)
     nd = S.shape[2]
+    cs = _census_scratch(gl, dmin, nd)
     step = 1 if forward else -1
     idx = np.arange(nd + 1).astype(np.uint16)
     jj = np.arange(nd + 1).astype(np.uint32)
     fb = np.empty((4, w), dtype=np.float32)
     mins = np.empty(w, dtype=np.uint16)
     Z = np.zeros(nd + 2, dtype=np.uint16)
+    rr = np.full(w, np.nan, dtype=np.float32)
     reuse = C.shape[0] > 0
     for i in range(i0, i1):
         y = i if forward else h - 1 - i
@@ -378,7 +441,7 @@ def _sweep(cl, crrev, vol, pl, prrev, term, S, C, P, M, crow, tot, forward, i0, 
                 for j in range(nd):
                     r[j] = np.uint16(cx[j])
         else:
-            _cost_row(cl, crrev, vol, pl, prrev, term, y, dmin, crow)
+            _cost_row(cl, crrev, gl, gr, vol, pl, prrev, term, y, dmin, crow, cs)
             if reuse:
                 for x in range(w):
                     cx = C[y, x]
@@ -421,7 +484,7 @@ def _sweep(cl, crrev, vol, pl, prrev, term, S, C, P, M, crow, tot, forward, i0, 
                 _sum_into(S[y, x], Z, h0, v2, Z, Z, nd, False)
         if finish:
             _decide_row(tot, mins, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc,
-                        acc16, sh, idx, jj, fb)
+                        acc16, sh, idx, jj, fb, rr, lr)
             if keep:
                 S[y] = tot
 
@@ -430,7 +493,8 @@ def _sweep(cl, crrev, vol, pl, prrev, term, S, C, P, M, crow, tot, forward, i0, 
 def _row_scratch(w, nd):
     """What a pass that decides rows one at a time keeps beside them: the decision's candidate
     indices (uint16, uint32) and sub-pixel rows, a row of minima, a zero row and the path
-    along the row's two pixel parities H (nd + 2, PAD at both ends)."""
+    along the row's two pixel parities H (nd + 2, PAD at both ends) and the right view's row
+    rr (_decide_row)."""
     idx = np.arange(nd + 1).astype(np.uint16)
     jj = np.arange(nd + 1).astype(np.uint32)
     fb = np.empty((4, w), dtype=np.float32)
@@ -439,7 +503,8 @@ def _row_scratch(w, nd):
     H = np.empty((2, nd + 2), dtype=np.uint16)
     H[:, 0] = PAD
     H[:, nd + 1] = PAD
-    return idx, jj, fb, mins, Z, H
+    rr = np.full(w, np.nan, dtype=np.float32)
+    return idx, jj, fb, mins, Z, H, rr
 
 
 @njit(cache=True, fastmath=True, inline="always")
@@ -460,8 +525,8 @@ OVERLAP = 24  # rows the lower stripe of the 5-path pass starts above its first 
 
 
 @njit(cache=True, fastmath=True)
-def _down(cl, crrev, vol, pl, prrev, term, S, P, M, crow, tot, y0, y1, warm, p1, p2, dmin,
-          uniqueness, fit, want_right, disp_l, disp_r, acc, acc16, sh, keep):
+def _down(cl, crrev, gl, gr, vol, pl, prrev, term, S, P, M, crow, tot, y0, y1, warm, p1, p2, dmin,
+          uniqueness, fit, want_right, disp_l, disp_r, acc, acc16, sh, keep, lr):
     """The 5-path pass over rows y0 .. y1 - 1, top to bottom: paths 1-3 from the top-left,
     top and top-right and 0 from the left in one sweep along the row (x rising), which leaves
     their sum in tot; then 4 from the right in a sweep back, which adds it and takes each
@@ -473,13 +538,14 @@ def _down(cl, crrev, vol, pl, prrev, term, S, P, M, crow, tot, y0, y1, warm, p1,
     back. Each sweep steps a chain along the row (each step waits for the one before) beside
     independent work (the three paths from above; the sums), which the processor overlaps.
     """
-    h, w = cl.shape
+    h, w = _size(cl, gl)
     nd = crow.shape[1]
-    idx, jj, fb, mins, Z, H = _row_scratch(w, nd)
+    cs = _census_scratch(gl, dmin, nd)
+    idx, jj, fb, mins, Z, H, rr = _row_scratch(w, nd)
     for i in range(y1 - y0 + warm):
         y = y0 - warm + i
         decided = i >= warm
-        _cost_row(cl, crrev, vol, pl, prrev, term, y, dmin, crow)
+        _cost_row(cl, crrev, gl, gr, vol, pl, prrev, term, y, dmin, crow, cs)
         b = i % 2
         a = 1 - b
         m0 = np.uint16(0)
@@ -509,20 +575,21 @@ def _down(cl, crrev, vol, pl, prrev, term, S, P, M, crow, tot, y0, y1, warm, p1,
             continue
         _from_the_right(crow, H, tot, mins, Z, p1, p2, nd)
         _decide_row(tot, mins, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc,
-                    acc16, sh, idx, jj, fb)
+                    acc16, sh, idx, jj, fb, rr, lr)
         if keep:
             S[y] = tot
 
 
 @njit(cache=True, fastmath=True)
-def _vertical(cl, crrev, vol, pl, prrev, term, forward, rows, K, ck, ckm, p1, p2, dmin):
+def _vertical(cl, crrev, gl, gr, vol, pl, prrev, term, forward, rows, K, ck, ckm, p1, p2, dmin):
     """The path from the bottom (not forward: rows h - 1 up to h - rows) or from the top
     (forward: rows 0 .. rows - 1) alone, keeping two rows of it. Going up, the path's row y is
     stored in ck[y // K - 1] (ckm: its minima) at every y that is a multiple of K above 0
     (the row below each block of the 4-path pass but the last); going down, its last row in
     ck[0]. ck is uint8 where every path cost fits (_four_path_layout), else uint16."""
-    h, w = cl.shape
+    h, w = _size(cl, gl)
     nd = ck.shape[2]
+    cs = _census_scratch(gl, dmin, nd)
     P = np.empty((2, w, nd + 2), dtype=np.uint16)
     P[:, :, 0] = PAD
     P[:, :, nd + 1] = PAD
@@ -530,7 +597,7 @@ def _vertical(cl, crrev, vol, pl, prrev, term, forward, rows, K, ck, ckm, p1, p2
     crow = np.empty((w, nd), dtype=np.uint16)
     for i in range(rows):
         y = i if forward else h - 1 - i
-        _cost_row(cl, crrev, vol, pl, prrev, term, y, dmin, crow)
+        _cost_row(cl, crrev, gl, gr, vol, pl, prrev, term, y, dmin, crow, cs)
         b = i % 2
         for x in range(w):
             if i == 0:
@@ -553,8 +620,8 @@ def _vertical(cl, crrev, vol, pl, prrev, term, forward, rows, K, ck, ckm, p1, p2
 
 
 @njit(cache=True, fastmath=True)
-def _four(cl, crrev, vol, pl, prrev, term, S, y0, y1, K, ck, ckm, top, topm, BB, CB, p1, p2,
-          dmin, uniqueness, fit, want_right, disp_l, disp_r, sh, keep):
+def _four(cl, crrev, gl, gr, vol, pl, prrev, term, S, y0, y1, K, ck, ckm, top, topm, BB, CB, p1, p2,
+          dmin, uniqueness, fit, want_right, disp_l, disp_r, sh, keep, lr):
     """The 4-path pass (left, right, top, bottom) over rows y0 .. y1 - 1 in blocks of K rows,
     without a volume: for each block, the path from the bottom is taken up through it again
     from the stored row below it (ck, ckm: _vertical; at the image's last row it starts),
@@ -564,9 +631,10 @@ def _four(cl, crrev, vol, pl, prrev, term, S, y0, y1, K, ck, ckm, top, topm, BB,
     _down, the sum with the stored bottom row, the decision. Every path cost is the one a
     whole-image pass gives, so the maps do not depend on K or on where a stripe starts.
     """
-    h, w = cl.shape
+    h, w = _size(cl, gl)
     nd = ck.shape[2]
-    idx, jj, fb, mins, Z, H = _row_scratch(w, nd)
+    cs = _census_scratch(gl, dmin, nd)
+    idx, jj, fb, mins, Z, H, rr = _row_scratch(w, nd)
     P = np.empty((2, w, nd + 2), dtype=np.uint16)
     P[:, :, 0] = PAD
     P[:, :, nd + 1] = PAD
@@ -594,7 +662,7 @@ def _four(cl, crrev, vol, pl, prrev, term, S, y0, y1, K, ck, ckm, top, topm, BB,
         b1 = min(b0 + K, y1)
         for y in range(b1 - 1, b0 - 1, -1):
             r = y - b0
-            _cost_row(cl, crrev, vol, pl, prrev, term, y, dmin, crow)
+            _cost_row(cl, crrev, gl, gr, vol, pl, prrev, term, y, dmin, crow, cs)
             if kept:
                 for x in range(w):
                     cx = CB[r, x]
@@ -623,7 +691,7 @@ def _four(cl, crrev, vol, pl, prrev, term, S, y0, y1, K, ck, ckm, top, topm, BB,
                     for j in range(nd):
                         c[j] = np.uint16(cx[j])
             else:
-                _cost_row(cl, crrev, vol, pl, prrev, term, y, dmin, crow)
+                _cost_row(cl, crrev, gl, gr, vol, pl, prrev, term, y, dmin, crow, cs)
             b = y % 2
             a = 1 - b
             m0 = np.uint16(0)
@@ -640,7 +708,7 @@ def _four(cl, crrev, vol, pl, prrev, term, S, y0, y1, K, ck, ckm, top, topm, BB,
                 _sum_into(tot[x], Z, h0, v, BB[r, x], Z, nd, False)
             _from_the_right(crow, H, tot, mins, Z, p1, p2, nd)
             _decide_row(tot, mins, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc,
-                        acc16, sh, idx, jj, fb)
+                        acc16, sh, idx, jj, fb, rr, lr)
             if keep:
                 S[y] = tot
 
@@ -662,10 +730,13 @@ def _buffers(n, w, nd):
 
 
 @njit(cache=True, parallel=True)
-def _match(cl, crrev, vol, pl, prrev, term, S, C, dmin, p1, p2, paths, uniqueness, fit,
-           want_right, keep, K, ck, ckm, top, topm, BB, CB):
-    """Semi-global matching of census images cl and crrev (see _cost_row): disparity maps of
-    the left and (want_right) right view in px, NaN where the uniqueness test rejects.
+def _match(cl, crrev, gl, gr, vol, pl, prrev, term, S, C, dmin, p1, p2, paths, uniqueness, fit,
+           want_right, keep, K, ck, ckm, top, topm, BB, CB, lr):
+    """Semi-global matching of census images cl and crrev, or (gl has rows) of the census
+    rows made from the padded grey images gl, gr where a pass needs them (see _cost_row):
+    disparity maps of the left and (want_right) right view in px, NaN where the uniqueness
+    test rejects. With lr >= 0 (and want_right) the left map is LR-checked row by row at
+    tolerance lr and the right map is not kept (an empty (0, cols) one is returned).
 
     vol: box-summed cost (rows, cols, nd), or an empty volume to take the cost row by row from
     the census rows and the planes pl, prrev (_cost_row; term[5]: the largest cost).
@@ -681,7 +752,7 @@ def _match(cl, crrev, vol, pl, prrev, term, S, C, dmin, p1, p2, paths, uniquenes
     whatever the thread count, so results do not depend on it.
     keep: leave the total path costs in S (rows, cols, nd; for tests).
     """
-    h, w = cl.shape
+    h, w = _size(cl, gl)
     nd = S.shape[2]
     # a path cost is at most the largest cost + P2, so every total is under paths times that:
     # if it fits with the candidate's bits below it, the right view's minimum runs in uint16
@@ -691,7 +762,7 @@ def _match(cl, crrev, vol, pl, prrev, term, S, C, dmin, p1, p2, paths, uniquenes
     cmax = int(term[5]) if vol.shape[0] == 0 else int(vol.max())
     sh = bits if bits > 0 and (paths * (cmax + int(p2)) + 1) << bits <= 0xFFFF else 0
     disp_l = np.full((h, w), np.nan, dtype=np.float32)
-    disp_r = np.full((h, w), np.nan, dtype=np.float32)
+    disp_r = np.full((h if lr < 0.0 else 0, w), np.nan, dtype=np.float32)
     upper = (h + 1) // 2
     if paths == 5:
         for k in prange(2):
@@ -699,9 +770,9 @@ def _match(cl, crrev, vol, pl, prrev, term, S, C, dmin, p1, p2, paths, uniquenes
             # reuses the first one's memory, so the peak holds one set
             P, M, crow, tot, acc, acc16 = _buffers(1, w, nd)
             y0, y1 = (0, upper) if k == 0 else (upper, h)
-            _down(cl, crrev, vol, pl, prrev, term, S, P[0], M[0], crow[0], tot[0], y0, y1,
+            _down(cl, crrev, gl, gr, vol, pl, prrev, term, S, P[0], M[0], crow[0], tot[0], y0, y1,
                   0 if k == 0 else min(OVERLAP, upper), p1, p2, dmin, uniqueness, fit,
-                  want_right, disp_l, disp_r, acc[0], acc16[0], sh, keep)
+                  want_right, disp_l, disp_r, acc[0], acc16[0], sh, keep, lr)
         return disp_l, disp_r
     if paths == 4:
         # the path from the bottom alone first, storing its row below every block; with two
@@ -712,17 +783,17 @@ def _match(cl, crrev, vol, pl, prrev, term, S, C, dmin, p1, p2, paths, uniquenes
         mid = (nblocks + 1) // 2 * K if stripes == 2 else h
         for k in prange(2):
             if k == 0:
-                _vertical(cl, crrev, vol, pl, prrev, term, False, max(h - K, 0), K, ck, ckm,
+                _vertical(cl, crrev, gl, gr, vol, pl, prrev, term, False, max(h - K, 0), K, ck, ckm,
                           p1, p2, dmin)
             elif stripes == 2:
-                _vertical(cl, crrev, vol, pl, prrev, term, True, mid, K, top, topm, p1, p2,
+                _vertical(cl, crrev, gl, gr, vol, pl, prrev, term, True, mid, K, top, topm, p1, p2,
                           dmin)
         for k in prange(2):
             if k < stripes:
                 y0, y1 = (0, mid) if k == 0 else (mid, h)
-                _four(cl, crrev, vol, pl, prrev, term, S, y0, y1, K, ck, ckm, top[0], topm[0],
-                      BB[k], CB[k], p1, p2, dmin, uniqueness, fit, want_right, disp_l, disp_r,
-                      sh, keep)
+                _four(cl, crrev, gl, gr, vol, pl, prrev, term, S, y0, y1, K, ck, ckm, top[0],
+                      topm[0], BB[k], CB[k], p1, p2, dmin, uniqueness, fit, want_right, disp_l,
+                      disp_r, sh, keep, lr)
         return disp_l, disp_r
     P, M, crow, tot, acc, acc16 = _buffers(2, w, nd)  # the directions go on from row to row
     diagonals = paths == 8
@@ -733,15 +804,17 @@ def _match(cl, crrev, vol, pl, prrev, term, S, C, dmin, p1, p2, paths, uniquenes
                 i0, i1 = 0, upper if forward else h - upper
             else:
                 i0, i1 = upper if forward else h - upper, h
-            _sweep(cl, crrev, vol, pl, prrev, term, S, C, P[k], M[k], crow[k], tot[k], forward, i0,
-                   i1, p1, p2, diagonals, phase == 1, dmin, uniqueness, fit, want_right, disp_l,
-                   disp_r, acc[k], acc16[k], sh, keep)
+            _sweep(cl, crrev, gl, gr, vol, pl, prrev, term, S, C, P[k], M[k], crow[k], tot[k],
+                   forward, i0, i1, p1, p2, diagonals, phase == 1, dmin, uniqueness, fit,
+                   want_right, disp_l, disp_r, acc[k], acc16[k], sh, keep, lr)
     return disp_l, disp_r
 
 
 NO_PLANES = np.zeros((0, 1, 1), dtype=np.uint8)
 NO_VOLUME = np.empty((0, 0, 0), dtype=np.uint16)
 NO_COSTS = np.empty((0, 0, 0), dtype=np.uint8)
+NO_GREY = np.empty((0, 0), dtype=np.uint8)
+NO_CENSUS = np.empty((0, 0), dtype=np.uint64)
 
 
 def census_term(outside: int = CENSUS_BITS) -> np.ndarray:
@@ -753,7 +826,8 @@ def match(cl: np.ndarray, crrev: np.ndarray, vol: np.ndarray, S: np.ndarray, dmi
           p1: np.uint16, p2: np.uint16, paths: int, uniqueness: float, fit: int,
           want_right: bool, keep: bool, pl: np.ndarray = NO_PLANES,
           prrev: np.ndarray = NO_PLANES, term: np.ndarray | None = None,
-          costs: np.ndarray = NO_COSTS, four: FourPath | None = None
+          costs: np.ndarray = NO_COSTS, four: FourPath | None = None,
+          gl: np.ndarray = NO_GREY, gr: np.ndarray = NO_GREY, lr: float = -1.0
           ) -> tuple[np.ndarray, np.ndarray]:
     """_match with the cost from vol, or (vol empty) from the census rows plus, where pl has
     channels, the intensity term of the planes pl and prrev (cost.reversed_planes) as
@@ -761,18 +835,22 @@ def match(cl: np.ndarray, crrev: np.ndarray, vol: np.ndarray, S: np.ndarray, dmi
     costs: with 8 paths and every cost under 256, a (rows, cols, nd) uint8 buffer in which
     each cost row is kept for the second direction (see _sweep), else NO_COSTS.
     four: the 4-path buffers (FourPath; made here for one stripe when not given).
-    S: (rows, cols, nd) with 8 paths or keep (the totals are left in it), else (0, 0, nd)."""
+    S: (rows, cols, nd) with 8 paths or keep (the totals are left in it), else (0, 0, nd).
+    gl, gr: the grey images padded as census takes them, the census rows then made where they
+    are used (cl, crrev: NO_CENSUS); lr: the LR check's tolerance, done row by row (no right
+    map is kept: the second map returned has no rows), or negative: no check, the right map
+    returned."""
     term = census_term() if term is None else term
-    h, w = cl.shape
+    h, w = (gl.shape[0] - 2 * CENSUS_H, gl.shape[1] - 2 * CENSUS_W) if gl.shape[0] else cl.shape
     nd = S.shape[2]
     if four is None:
         four = FourPath.make(h, w, nd, largest_cost(vol, term), int(p2), vol.shape[0] == 0,
                              1 if paths == 4 else 0)
     disp_l: np.ndarray
     disp_r: np.ndarray
-    disp_l, disp_r = _match(cl, crrev, vol, pl, prrev, term, S, costs, dmin, p1, p2, paths,
+    disp_l, disp_r = _match(cl, crrev, gl, gr, vol, pl, prrev, term, S, costs, dmin, p1, p2, paths,
                             uniqueness, fit, want_right, keep, four.K, four.ck, four.ckm,
-                            four.top, four.topm, four.BB, four.CB)
+                            four.top, four.topm, four.BB, four.CB, float(lr))
     return disp_l, disp_r
 
 

@@ -87,14 +87,22 @@ def box_cost(cl: np.ndarray, cr: np.ndarray, dmin: int, nd: int, box: int) -> np
     return s.astype(np.uint16)
 
 
-def run(config) -> tuple[np.ndarray, np.ndarray]:
-    """(left, right) maps of sgm.match for one configuration on images()."""
+def run(config, rows: bool = False, lr: float = -1.0) -> tuple[np.ndarray, np.ndarray]:
+    """(left, right) maps of sgm.match for one configuration on images(); rows (census-row
+    configurations only): sgm.match is given the padded grey images and makes the census rows
+    itself; lr: its LR tolerance (row by row; the right map is then empty)."""
     paths, dmin, nd, box, uniq, fit, p1, p2 = config
     cl, cr = (census(v) for v in images())
     vol = box_cost(cl, cr, dmin, nd, box) if box else np.empty((0, 0, 0), np.uint16)
     sums = np.empty((H, W, nd) if paths != 5 else (0, 0, nd), np.uint16)
-    return sgm.match(cl, sgm.reversed_right(cr, dmin, nd), vol, sums, dmin, np.uint16(p1),
-                     np.uint16(p2), paths, uniq, fit, True, False)
+    crrev = sgm.reversed_right(cr, dmin, nd)
+    gl, gr = sgm.NO_GREY, sgm.NO_GREY
+    if rows:
+        gl, gr = (np.pad(v, ((sgm.CENSUS_H,) * 2, (sgm.CENSUS_W,) * 2), mode="edge")
+                  for v in images())
+        cl, crrev = sgm.NO_CENSUS, sgm.NO_CENSUS
+    return sgm.match(cl, crrev, vol, sums, dmin, np.uint16(p1), np.uint16(p2), paths, uniq,
+                     fit, True, False, gl=gl, gr=gr, lr=lr)
 
 
 def pack(disp: np.ndarray) -> np.ndarray:

@@ -15,6 +15,7 @@ import pytest
 from host.errors import HostError
 from host.stereo import MatcherParams, compute_disparity, evaluate, load_scene, sgm
 from host.stereo.matcher import numba_threads
+from host.stereo.postprocess import lr_consistency
 from host.stereo.synthetic import Layer, random_texture, render_pair, synthetic_scene
 from tests.stereo import sgm_reference
 
@@ -236,6 +237,34 @@ def test_sgm_maps_equal_the_reference_written_before_the_speed_rework(i: int) ->
     left, right = sgm_reference.run(sgm_reference.CONFIGS[i])
     np.testing.assert_array_equal(left, sgm_reference.unpack(stored[f"left{i}"]))
     np.testing.assert_array_equal(right, sgm_reference.unpack(stored[f"right{i}"]))
+
+
+CENSUS_ROWS = [i for i, c in enumerate(sgm_reference.CONFIGS) if c[3] == 0]
+
+
+@pytest.mark.parametrize("i", CENSUS_ROWS)
+def test_census_rows_made_in_the_passes_give_the_reference_maps(i: int) -> None:
+    # given the padded grey images instead of census images, each pass makes the census rows
+    # it needs (no census image kept): the maps are still sgm_reference.npz's
+    stored = np.load(sgm_reference.FILE)
+    left, right = sgm_reference.run(sgm_reference.CONFIGS[i], rows=True)
+    np.testing.assert_array_equal(left, sgm_reference.unpack(stored[f"left{i}"]))
+    np.testing.assert_array_equal(right, sgm_reference.unpack(stored[f"right{i}"]))
+
+
+@pytest.mark.parametrize("tol", [0.0, 1.0])
+@pytest.mark.parametrize("i", [CENSUS_ROWS[k] for k in (0, 10, 21)] + [
+    sgm_reference.CONFIGS.index((4, 0, 30, 0, 5.0, 2, 11, 60)),
+    sgm_reference.CONFIGS.index((5, 0, 56, 0, 10.0, 1, 8, 32))])
+def test_lr_check_row_by_row_equals_the_check_on_the_whole_maps(i: int, tol: float) -> None:
+    # with an LR tolerance sgm.match checks each left row against the right row it just made
+    # and keeps no right map: the same left map as lr_consistency on the reference's two maps
+    stored = np.load(sgm_reference.FILE)
+    want = lr_consistency(sgm_reference.unpack(stored[f"left{i}"]),
+                          sgm_reference.unpack(stored[f"right{i}"]), tol)
+    left, right = sgm_reference.run(sgm_reference.CONFIGS[i], lr=tol)
+    assert right.shape[0] == 0
+    np.testing.assert_array_equal(left, want)
 
 
 @pytest.mark.parametrize("stripes", [1, 2])
