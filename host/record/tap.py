@@ -19,6 +19,7 @@ from host.link import protocol_gen as gen
 from host.record import messages as m
 from host.record.writer import Message, Recorder
 from host.servo.loop import marker_band
+from host.servo.phase import Phase
 from host.servo.snapshot import Snapshot
 
 Search = Callable[[Snapshot], tuple[float, float]]  # the disparity range a map was searched in
@@ -157,7 +158,7 @@ def step_statuses(snap: Snapshot) -> list[Any]:
         out.append(m.status("drive", m.OK, f"{row.left} {row.right}",
                             {"left": int(row.left), "right": int(row.right)}))
     text = snap.phase + (f": {snap.reason}" if snap.reason else "")
-    out.insert(0, m.status("servo", m.ERROR if snap.phase == "stop" else level, text, values))
+    out.insert(0, m.status("servo", m.ERROR if snap.phase == Phase.STOP else level, text, values))
     if snap.link is not None:
         link = dataclasses.asdict(snap.link)
         bad = snap.link.resets or not np.isfinite(snap.link.rtt_ms)
