@@ -70,9 +70,9 @@ def servo_range(servo: Any) -> Search:
 
     def search(snap: Snapshot) -> tuple[float, float]:
         if snap.disparity_y0 == 0 and snap.disparity is not None and \
-                snap.disparity.shape[0] == snap.left.shape[0] or snap.marker is None:
+                snap.disparity.shape[0] == snap.left.shape[0] or snap.marker_pair is None:
             return whole(snap)
-        p = marker_band(servo.params, snap.marker.disparity)
+        p = marker_band(servo.params, snap.marker_pair.disparity)
         return float(p.min_disparity), float(p.min_disparity + p.num_disparities)
     return search
 
@@ -123,7 +123,7 @@ def step_messages(snap: Snapshot, ns: int, search: Search) -> list[Message]:
         out.append(("/stereo/disparity", m.disparity(snap.disparity, snap.disparity_y0,
                                                      snap.left.shape[:2], g, search(snap), ns),
                     ns))
-    pair = snap.marker
+    pair = snap.marker_pair
     if pair is not None and pair.disparity > 0:
         left = pair.left
         out.append(("/servo/marker", m.point(*m.at_disparity(g, left.u, left.v, pair.disparity),

@@ -124,7 +124,7 @@ def marker_disparity(left: np.ndarray, right: np.ndarray, params: MatcherParams,
 
 @dataclass(frozen=True)
 class ServoConfig:
-    marker: str = "disc"  # or "aruco"
+    marker_kind: str = "disc"  # or "aruco"
     marker_radius_m: float | None = 0.03  # the disc's radius on the card; None: unknown
     reference_frames: int = 5
     min_area: int | None = None  # px; None: 1% of the image
@@ -178,7 +178,7 @@ class Step:
     disparity: np.ndarray | None  # the disparity computed this step (band or map), if any
     disparity_rows: tuple[int, int]  # the rows of the frame that disparity covers
     target: Target
-    marker: MarkerPair | None
+    marker_pair: MarkerPair | None
     row: LogRow
 
 
@@ -199,7 +199,7 @@ class Servo:
                  geometry: Geometry, control: ControlConfig = ControlConfig(),
                  config: ServoConfig | None = None,
                  clock: Callable[[], float] = time.monotonic, **overrides: Any) -> None:
-        """overrides: fields of ServoConfig (marker=, marker_radius_m=, full_map= ...)."""
+        """overrides: fields of ServoConfig (marker_kind=, marker_radius_m=, full_map= ...)."""
         self.cfg = dataclasses.replace(config or ServoConfig(), **overrides)
         self.source, self.link, self.params = source, link, params
         self.geometry, self.control, self.clock = geometry, control, clock
@@ -368,7 +368,7 @@ class Servo:
         for whole in (False, True):
             if whole and (self.last_pair is None or not seen.rejected):
                 break
-            candidates = marker_candidates(frame.left, frame.right, cfg.marker,
+            candidates = marker_candidates(frame.left, frame.right, cfg.marker_kind,
                                            cfg.marker_radius_m, g.baseline_m, self.last_pair,
                                            whole=whole)
             checked = 0

@@ -44,7 +44,7 @@ class Snapshot:
     disparity: np.ndarray | None  # px, NaN = invalid; rows disparity_y0.. of the image
     disparity_y0: int  # the full map (0) or a band of rows over the marker
     target: Target | None
-    marker: MarkerPair | None  # the marker seen in both views (None: not seen)
+    marker_pair: MarkerPair | None  # the marker seen in both views (None: not seen)
     row: Any  # the step's LogRow (None in the reference phase)
     link: LinkStats | None
     geometry: Geometry

@@ -88,7 +88,7 @@ class ViewFeed:
             duty: tuple[int | None, int | None] = (int(row.left), int(row.right))
         else:
             target_px = snap.target.disparity if snap.target is not None else math.nan
-            robot_px = snap.marker.disparity if snap.marker is not None else math.nan
+            robot_px = snap.marker_pair.disparity if snap.marker_pair is not None else math.nan
             duty = (None, None)
         target = g.depth_m(target_px) if target_px > 0 else None  # NaN > 0 is False
         robot = g.depth_m(robot_px) if robot_px > 0 else None

@@ -25,11 +25,11 @@ def test_observers_see_every_step_and_stop_is_sent():
         moving = [s for s in seen[5:] if s.row.left or s.row.right]
         assert moving and moving[-1].reason == ""
         assert len(seen) == 45 and [s.row for s in seen[5:]] == rows
-        marked = [s for s in seen[5:] if s.marker is not None]
+        marked = [s for s in seen[5:] if s.marker_pair is not None]
         assert marked, "the marker is found in some steps"
         band = marked[-1]
         assert band.disparity is not None and band.disparity.shape[1] == 320
-        v = band.marker.left.v
+        v = band.marker_pair.left.v
         assert band.disparity_y0 <= v < band.disparity_y0 + len(band.disparity)
         assert band.target is servo.target and band.left.shape[:2] == (240, 320)
         assert band.link.schema_hash == link.hello.schema_hash and band.link.rtt_ms > 0
