@@ -272,6 +272,8 @@ class Servo:
         return StereoFrame(frame.left, match_exposure(frame.left, frame.right), frame.t_left,
                            frame.t_right)
 
+    # ------------------------------------------------------- the user's stop and the observers
+
     def request_stop(self, reason: str) -> None:
         """Stop the robot at the next frame (any thread may call this); that step's phase is
         "stop", and the caller's loop ends there."""
@@ -280,6 +282,7 @@ class Servo:
     def _notify(self, frame: StereoFrame, phase: Phase, reason: str, disp: np.ndarray | None,
                 y0: int, pair: MarkerPair | None, row: LogRow | None,
                 rtt_ms: float = math.nan) -> None:
+        """Hand each observer this step's Snapshot (they return at once: snapshot.py)."""
         if self.observers:
             snap = Snapshot(self.clock(), phase, reason, frame.left, disp, y0, self.target, pair,
                             row, link_stats(self.link, rtt_ms), self.geometry)
