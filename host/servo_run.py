@@ -9,6 +9,7 @@ from dataclasses import dataclass
 
 from host.camera.source import CameraError
 from host.servo.loop import LogRow, Servo
+from host.servo.phase import Phase
 
 HELD, STOPPED, DURATION, NOT_SETTLED, LOST, ENDED, UNSAFE = (
     "held", "stopped", "duration", "not settled", "lost", "camera ended", "unsafe")
@@ -61,10 +62,10 @@ def run_servo(servo: Servo, rules: Rules, clock: Callable[[], float],
             return End(UNSAFE, why)
         # only on the step that sent STOP: a stop requested from another thread (the view's
         # STOP) while a step was deciding takes effect at the next step, which sends it
-        if row.phase == "stop":
+        if row.phase == Phase.STOP:
             return End(STOPPED, servo.stop_reason or row.reason)
         lost_since = (lost_since if lost_since is not None else row.t) \
-            if row.phase == "lost" else None
+            if row.phase == Phase.LOST else None
         if rules.lost_s is not None and lost_since is not None \
                 and row.t - lost_since > rules.lost_s:
             return End(LOST, f"marker lost for {rules.lost_s:g} s")

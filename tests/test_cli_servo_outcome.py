@@ -13,6 +13,7 @@ import pytest
 from host.cli import main
 from host.commands.servo_outcome import NOT_REACHED, outcome
 from host.servo.loop import LogRow, run_outcome
+from host.servo.phase import Phase
 
 
 def _row(t: float, phase: str, robot_px: float = math.nan, reason: str = "") -> LogRow:
@@ -32,16 +33,18 @@ class _Run:
 
 
 @pytest.mark.parametrize("rows, stop, status, words", [
-    ([_row(0, "hold"), _row(1, "lost", reason="marker lost")], None, NOT_REACHED,
+    ([_row(0, Phase.HOLD), _row(1, Phase.LOST, reason="marker lost")], None, NOT_REACHED,
      "never seen in 2 frames"),
-    ([_row(0, "drive", 18.0), _row(1, "lost", reason="marker lost")], None, NOT_REACHED,
+    ([_row(0, Phase.DRIVE, 18.0), _row(1, Phase.LOST, reason="marker lost")], None, NOT_REACHED,
      "safe stop after 1.0 s: marker lost"),
-    ([_row(0, "drive", 18.0), _row(1, "stale", reason="stale")], None, NOT_REACHED, "stale"),
-    ([_row(0, "drive", 18.0), _row(1, "stop", 19.0, "target vanished")], None, NOT_REACHED,
+    ([_row(0, Phase.DRIVE, 18.0), _row(1, Phase.STALE, reason="stale")], None, NOT_REACHED,
+     "stale"),
+    ([_row(0, Phase.DRIVE, 18.0), _row(1, Phase.STOP, 19.0, "target vanished")], None, NOT_REACHED,
      "target vanished"),
-    ([_row(0, "drive", 18.0), _row(1, "hold", 20.1)], None, 0, "held at 1.244 m"),
-    ([_row(0, "drive", 18.0), _row(1, "drive", 19.0)], None, 0, "stopped while in phase drive"),
-    ([_row(0, "drive", 18.0), _row(1, "stop", 19.0, "pressed")], "pressed", 0,
+    ([_row(0, Phase.DRIVE, 18.0), _row(1, Phase.HOLD, 20.1)], None, 0, "held at 1.244 m"),
+    ([_row(0, Phase.DRIVE, 18.0), _row(1, Phase.DRIVE, 19.0)], None, 0,
+     "stopped while in phase drive"),
+    ([_row(0, Phase.DRIVE, 18.0), _row(1, Phase.STOP, 19.0, "pressed")], "pressed", 0,
      "stopped (pressed)"),
     ([], None, NOT_REACHED, "before the robot phase"),
 ])

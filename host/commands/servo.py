@@ -75,7 +75,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
                    help="largest duty while driving (permille)")
     p.add_argument("--min-duty", type=int_range(0, 1000), default=180,
                    help="least duty that moves the robot (permille)")
-    p.add_argument("--marker", choices=("disc", "aruco"), default="disc",
+    p.add_argument("--marker", dest="marker_kind", choices=("disc", "aruco"), default="disc",
                    help="the robot's marker: a dark disc, or an ArUco tag")
     p.add_argument("--marker-radius-cm", type=NON_NEGATIVE, default=3.0,
                    help="radius of the marker's dark disc (0: do not check sizes)")
@@ -196,7 +196,7 @@ def run(args: argparse.Namespace) -> int:
         source = check_recorded(args, stack.enter_context(open_source(args)))
         geometry = source_geometry(args, source)
         clock = getattr(source, "clock", time.monotonic)  # a bag's own clock (its stamps)
-        servo = Servo(source, link, params, geometry, _control(args), marker=args.marker,
+        servo = Servo(source, link, params, geometry, _control(args), marker_kind=args.marker_kind,
                       marker_radius_m=args.marker_radius_cm / 100 if args.marker_radius_cm
                       else None, clock=clock)
         return _servo(args, servo, geometry, None, clock)

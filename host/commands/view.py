@@ -19,6 +19,7 @@ from host.commands.swap_check import check_recorded
 from host.errors import HostError
 from host.record import add_record_options, check_record, recording
 from host.servo.marker import find_marker
+from host.servo.phase import Phase
 from host.servo.snapshot import Snapshot
 from host.stereo.matcher import compute_disparity
 
@@ -144,7 +145,7 @@ def run(args: argparse.Namespace) -> int:
         for frame in source:
             disp = compute_disparity(frame.left, frame.right, params)
             last = find_marker(frame.left, frame.right, "disc", None, geometry.baseline_m, last)
-            snap = Snapshot(time.monotonic() - t0, "view", "no robot: looking only", frame.left,
+            snap = Snapshot(time.monotonic() - t0, Phase.VIEW, "no robot: looking only", frame.left,
                             disp, 0, None, last, None, None, geometry)
             for observer in observers:
                 observer(snap)
@@ -153,7 +154,7 @@ def run(args: argparse.Namespace) -> int:
         ended = getattr(source, "ended", None)
         how = ended() if callable(ended) else "the camera ended"
         if snap is not None:  # the page says so too, over the last frame
-            view.feed(dataclasses.replace(snap, t=time.monotonic() - t0, phase="ended",
+            view.feed(dataclasses.replace(snap, t=time.monotonic() - t0, phase=Phase.ENDED,
                                           reason=f"{how}: the last frame is shown"))
         print(f"host view: {how}; the page shows its last frame (Ctrl-C to quit)",
               file=sys.stderr, flush=True)

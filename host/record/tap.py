@@ -19,6 +19,7 @@ from host.link import protocol_gen as gen
 from host.record import messages as m
 from host.record.writer import Message, Recorder
 from host.servo.loop import marker_band
+from host.servo.phase import Phase
 from host.servo.snapshot import Snapshot
 
 Search = Callable[[Snapshot], tuple[float, float]]  # the disparity range a map was searched in
@@ -69,9 +70,9 @@ def servo_range(servo: Any) -> Search:
 
     def search(snap: Snapshot) -> tuple[float, float]:
         if snap.disparity_y0 == 0 and snap.disparity is not None and \
-                snap.disparity.shape[0] == snap.left.shape[0] or snap.marker is None:
+                snap.disparity.shape[0] == snap.left.shape[0] or snap.marker_pair is None:
             return whole(snap)
-        p = marker_band(servo.params, snap.marker.disparity)
+        p = marker_band(servo.params, snap.marker_pair.disparity)
         return float(p.min_disparity), float(p.min_disparity + p.num_disparities)
     return search
 
@@ -122,7 +123,7 @@ def step_messages(snap: Snapshot, ns: int, search: Search) -> list[Message]:
         out.append(("/stereo/disparity", m.disparity(snap.disparity, snap.disparity_y0,
                                                      snap.left.shape[:2], g, search(snap), ns),
                     ns))
-    pair = snap.marker
+    pair = snap.marker_pair
     if pair is not None and pair.disparity > 0:
         left = pair.left
         out.append(("/servo/marker", m.point(*m.at_disparity(g, left.u, left.v, pair.disparity),
@@ -157,7 +158,7 @@ def step_statuses(snap: Snapshot) -> list[Any]:
         out.append(m.status("drive", m.OK, f"{row.left} {row.right}",
                             {"left": int(row.left), "right": int(row.right)}))
     text = snap.phase + (f": {snap.reason}" if snap.reason else "")
-    out.insert(0, m.status("servo", m.ERROR if snap.phase == "stop" else level, text, values))
+    out.insert(0, m.status("servo", m.ERROR if snap.phase == Phase.STOP else level, text, values))
     if snap.link is not None:
         link = dataclasses.asdict(snap.link)
         bad = snap.link.resets or not np.isfinite(snap.link.rtt_ms)

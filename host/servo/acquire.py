@@ -21,7 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-FIND, MEASURE, PROBE, DONE = "find", "measure", "probe", "done"
+from host.servo.phase import Phase
+
 NEVER_SEEN = "the marker was never seen"
 NOT_MOVED = "the marker did not move when the robot was driven"
 
@@ -46,7 +47,7 @@ class Order:
 
     left: int
     right: int
-    phase: str
+    phase: Phase
 
 
 class Acquisition:
@@ -55,7 +56,7 @@ class Acquisition:
         """facing_away: the heading already known (a re-acquisition where it cannot have
         changed): no probe move, done after the measure."""
         self.cfg = config
-        self.phase = FIND if config.noise_frames > 0 else DONE
+        self.phase = Phase.FIND if config.noise_frames > 0 else Phase.DONE
         self.disparities: list[float] = []  # the standing robot's, for its noise
         self.facing_away = facing_away  # learnt by the probe (None: not yet)
         self.probes = facing_away is None
@@ -67,7 +68,7 @@ class Acquisition:
 
     @property
     def done(self) -> bool:
-        return self.phase == DONE
+        return self.phase == Phase.DONE
 
     def update(self, t: float, position: tuple[float, float] | None,
                disparity: float | None, noise_m: float = 0.0) -> Order:
@@ -76,58 +77,58 @@ class Acquisition:
         (m, standard deviation; the probe's move must be well beyond it)."""
         if self._t0 is None:
             self._t0 = t
-        if self.phase == FIND:
+        if self.phase == Phase.FIND:
             return self._find(t, position is not None)
-        if self.phase == MEASURE:
+        if self.phase == Phase.MEASURE:
             if disparity is not None:
                 self._seen_t = t
                 self.disparities.append(disparity)
                 if len(self.disparities) >= self.cfg.noise_frames:
-                    self._begin(PROBE if self.probes else DONE, t)
+                    self._begin(Phase.PROBE if self.probes else Phase.DONE, t)
             elif t - max(t if self._t0 is None else self._t0, self._seen_t) > \
                     self.cfg.find_wait_s:
                 # gone again before the measure was done (seen edge-on at the end of a turn,
                 # a glimpse): find it again, spinning if need be, rather than wait for ever
                 self.disparities.clear()
-                self._begin(FIND, t)
-            return Order(0, 0, MEASURE)
-        if self.phase == PROBE:
+                self._begin(Phase.FIND, t)
+            return Order(0, 0, Phase.MEASURE)
+        if self.phase == Phase.PROBE:
             return self._probe(t, position, noise_m)
-        return Order(0, 0, DONE)
+        return Order(0, 0, Phase.DONE)
 
     def interrupted(self, t: float) -> None:
         """A frame at t not fit to use (stale, a sensor frozen): what the measure or the probe
         saw so far is dropped and the phase begins again at the next usable frame (the robot
         stands meanwhile). A probe timed across a frozen sensor would find that the marker did
         not move, and leave the true marker out as a look-alike."""
-        if self.phase in (MEASURE, PROBE):
-            if self.phase == MEASURE:
+        if self.phase in (Phase.MEASURE, Phase.PROBE):
+            if self.phase == Phase.MEASURE:
                 self.disparities.clear()
             self._track.clear()
             self._t0 = None  # the phase's clock starts again at the next usable frame
 
-    def _begin(self, phase: str, t: float) -> None:
+    def _begin(self, phase: Phase, t: float) -> None:
         self.phase, self._t0 = phase, t
 
     def _find(self, t: float, seen: bool) -> Order:
         assert self._t0 is not None
         if seen:
-            self._begin(MEASURE, t)
-            return Order(0, 0, MEASURE)
+            self._begin(Phase.MEASURE, t)
+            return Order(0, 0, Phase.MEASURE)
         waited = t - self._t0
         if waited < self.cfg.find_wait_s:
-            return Order(0, 0, "wait")
+            return Order(0, 0, Phase.WAIT)
         if waited > self.cfg.find_wait_s + self.cfg.find_s:
             self.fault = NEVER_SEEN
-            return Order(0, 0, FIND)
+            return Order(0, 0, Phase.FIND)
         d = self.cfg.search_duty
-        return Order(d, -d, FIND)
+        return Order(d, -d, Phase.FIND)
 
     def _probe(self, t: float, position: tuple[float, float] | None, noise_m: float) -> Order:
         assert self._t0 is not None
         cfg = self.cfg
         if position is None:
-            return Order(0, 0, PROBE)  # not seen: stand until it is
+            return Order(0, 0, Phase.PROBE)  # not seen: stand until it is
         self._track.append((t, *position))
         if len(self._track) >= 10:
             # the move so far: the median of the last five sightings against the first five's
@@ -141,15 +142,15 @@ class Acquisition:
             if moved >= max(cfg.probe_m, 3 * noise_m) or (
                     t - self._t0 > cfg.probe_s and moved >= cfg.probe_m):
                 self.facing_away = (dz > 0) == (self.direction > 0)
-                self._begin(DONE, t)
-                return Order(0, 0, PROBE)
+                self._begin(Phase.DONE, t)
+                return Order(0, 0, Phase.PROBE)
         if t - self._t0 > cfg.probe_s:
             self.fault = NOT_MOVED
-            return Order(0, 0, PROBE)
+            return Order(0, 0, Phase.PROBE)
         duty = min(cfg.max_probe_duty,
                    cfg.probe_duty + cfg.probe_step * int((t - self._t0) / cfg.probe_step_s))
         duty *= self.direction
-        return Order(duty, duty, PROBE)
+        return Order(duty, duty, Phase.PROBE)
 
     def noise_px(self) -> float:
         """The standing robot's disparity noise a frame (px, standard deviation)."""

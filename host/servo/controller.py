@@ -46,8 +46,8 @@ from typing import Any
 
 import numpy as np
 
-WAIT, HOLD, DRIVE, CREEP, TURN, LOST, STALE, SEARCH, BLOCKED = (
-    "wait", "hold", "drive", "creep", "turn", "lost", "stale", "search", "blocked")
+from host.servo.phase import Phase
+
 LINE_BLOCKED = "the robot's line passes through the object"
 PUSHED = "pushed sideways onto the object while holding"
 DRIFTED = "drifting sideways onto the object while the marker is unseen"
@@ -109,7 +109,7 @@ class Observation:
 class Command:
     left: int
     right: int
-    phase: str
+    phase: Phase
     error_m: float | None
 
     @property
@@ -124,7 +124,7 @@ class Controller:
         self.target_m = target_m
         self.cfg = config
         self.facing_away = True
-        self.phase = WAIT
+        self.phase = Phase.WAIT
         self.seen = False
         self.missing = 0
         self.floor = config.min_duty
@@ -163,7 +163,7 @@ class Controller:
             xs = float(np.polyfit(t, np.array(lat, float), 1)[0])
         return float(z0), float(zs), xs
 
-    def _stop(self, phase: str, error: float | None) -> Command:
+    def _stop(self, phase: Phase, error: float | None) -> Command:
         self.phase = phase
         return Command(0, 0, phase, error)
 
@@ -272,27 +272,28 @@ class Controller:
 
     def update(self, obs: Observation) -> Command:
         if self.fault:
-            return self._stop(BLOCKED, None)
+            return self._stop(Phase.BLOCKED, None)
         if self._turn is not None:
             return self._turning(obs)
         if obs.depth_m is None:
             self.missing += 1
             self._seen_run = 0
-            if self.phase in (HOLD, WAIT, LOST) and self._pushed(obs.t, seen=False):
+            standing = self.phase in (Phase.HOLD, Phase.WAIT, Phase.LOST)
+            if standing and self._pushed(obs.t, seen=False):
                 self.fault = PUSHED
-                return self._stop(BLOCKED, None)
+                return self._stop(Phase.BLOCKED, None)
             if obs.invalid:
-                return self._stop(STALE, None)
+                return self._stop(Phase.STALE, None)
             if not self.seen:
-                return self._stop(WAIT, None)
+                return self._stop(Phase.WAIT, None)
             # stopped at once; after lost_frames of them the marker is lost
             if self.missing <= self.cfg.lost_frames:
-                return self._stop(WAIT, None)
+                return self._stop(Phase.WAIT, None)
             if self._search_until is not None and obs.t < self._search_until:
-                self.phase = SEARCH  # turned, but the card is not back: spin on to find it
+                self.phase = Phase.SEARCH  # turned, but the card is not back: spin on to find it
                 d = self.cfg.search_duty
-                return Command(d, -d, SEARCH, None)
-            return self._stop(LOST, None)
+                return Command(d, -d, Phase.SEARCH, None)
+            return self._stop(Phase.LOST, None)
         self.missing = 0
         self.seen = True
         self._seen_run += 1
@@ -312,24 +313,24 @@ class Controller:
         dt = obs.t - self._last_t if self._last_t is not None else 0.0
         self._last_t = obs.t
         if abs(e) < cfg.block_m and self.overlaps(obs.lateral_m, cfg.block_margin_m):
-            self.fault = PUSHED if self.phase == HOLD else LINE_BLOCKED
-            return self._stop(BLOCKED, e)
+            self.fault = PUSHED if self.phase == Phase.HOLD else LINE_BLOCKED
+            return self._stop(Phase.BLOCKED, e)
         if abs(e) < cfg.block_m and obs.lateral_m is not None:
             self._beside.append((obs.t, obs.lateral_m))
             self._beside = [o for o in self._beside if obs.t - o[0] <= cfg.drift_s]
         else:
             self._beside.clear()
-        if self.phase == HOLD and self._pushed(obs.t):
+        if self.phase == Phase.HOLD and self._pushed(obs.t):
             self.fault = PUSHED
-            return self._stop(BLOCKED, e)
-        if self.phase == HOLD and abs(e) <= cfg.tolerance_m:
-            return self._stop(HOLD, e)
-        moving_in = self.phase in (DRIVE, CREEP)
+            return self._stop(Phase.BLOCKED, e)
+        if self.phase == Phase.HOLD and abs(e) <= cfg.tolerance_m:
+            return self._stop(Phase.HOLD, e)
+        moving_in = self.phase in (Phase.DRIVE, Phase.CREEP)
         predicted = e + zdot * cfg.stop_lead_s
         if moving_in and (predicted * e <= 0 or abs(predicted) < 0.1 * cfg.tolerance_m):
-            return self._stop(HOLD, e)  # reached zero error (from either side): stop there
+            return self._stop(Phase.HOLD, e)  # reached zero error (from either side): stop there
         if not moving_in and abs(e) <= 0.25 * cfg.tolerance_m:
-            return self._stop(HOLD, e)
+            return self._stop(Phase.HOLD, e)
         forward = away == self.facing_away
         if forward:
             self._reversing = False
@@ -340,7 +341,7 @@ class Controller:
             # reverse instead, along the robot's line (the body checks as for any drive)
             self._reversing = True
         creeping = abs(e) <= cfg.creep_m
-        if creeping and self.phase == CREEP and abs(zdot) < 0.004:
+        if creeping and self.phase == Phase.CREEP and abs(zdot) < 0.004:
             self.floor = min(cfg.max_duty // 2 + 100, self.floor + cfg.creep_step)
         gain = cfg.gain_per_m * cfg.ref_depth_m / max(z, 0.3)
         duty = self.floor if creeping else min(cfg.max_duty, int(self.floor + gain * abs(e)))
@@ -353,7 +354,7 @@ class Controller:
             s = 1.0 if away else -1.0
             drift = obs.lateral_m - lane
             moving = abs(zdot) > 0.02  # the heading shows only in motion
-            if moving and self.phase == DRIVE and 0 < dt < 0.5:
+            if moving and self.phase == Phase.DRIVE and 0 < dt < 0.5:
                 # the wheel that lags stays the same one whichever way the robot faces
                 w = s if forward else -s
                 self.trim = max(-cfg.max_trim, min(cfg.max_trim, self.trim + w * cfg.trim_gain
@@ -364,7 +365,7 @@ class Controller:
             # dead zone, spins it in place; only the wheels' trim acts there
             steer = (0.0 if creeping else max(-abs(duty) / 2, min(abs(duty) / 2, pd)))
             steer += self.trim * duty
-        self.phase = CREEP if creeping else DRIVE
+        self.phase = Phase.CREEP if creeping else Phase.DRIVE
         left, right = duty - steer, duty + steer
         lift = self.floor - min(abs(left), abs(right))  # no wheel below the least duty that moves
         if lift > 0:
@@ -380,9 +381,9 @@ class Controller:
         return self._spin(e)
 
     def _spin(self, e: float | None) -> Command:
-        self.phase = TURN
+        self.phase = Phase.TURN
         d = self.cfg.turn_duty
-        return Command(d, -d, TURN, e)
+        return Command(d, -d, Phase.TURN, e)
 
     def _turning(self, obs: Observation) -> Command:
         """Spin until the card, lost edge-on, comes back and has turned the remaining angle."""
@@ -422,7 +423,7 @@ class Controller:
         self.facing_away = not self.facing_away
         self.history.clear()
         self.missing = 0
-        return self._stop(WAIT, None)
+        return self._stop(Phase.WAIT, None)
 
 
 def merged(spans: list[tuple[float, float]]) -> list[tuple[float, float]]:

@@ -14,8 +14,9 @@
     whole map matched a band of rows per frame, StripMap).
 
 Each piece is a state machine of its own (FrameTiming, Estimator, Acquisition, TargetTracker,
-Controller); step() composes them. Time comes from the frames' capture timestamps. Any
-exception leaves through the link's context manager, which sends STOP.
+Controller, Recovery, Progress); step() composes them, and each step has one Phase (phase.py).
+Time comes from the frames' capture timestamps. Any exception leaves through the link's context
+manager, which sends STOP.
 """
 
 from __future__ import annotations
@@ -66,6 +67,7 @@ from host.servo.perception import (
     stopping_distance_m,
     without_floor,
 )
+from host.servo.phase import Phase
 from host.servo.progress import Progress, ProgressConfig
 from host.servo.recovery import LANE, MOVED, RESET, RESUME, TARGET, Recovery, servo_bounds
 from host.servo.recovery import OUTSIDE as OUTSIDE_KIND
@@ -122,7 +124,7 @@ def marker_disparity(left: np.ndarray, right: np.ndarray, params: MatcherParams,
 
 @dataclass(frozen=True)
 class ServoConfig:
-    marker: str = "disc"  # or "aruco"
+    marker_kind: str = "disc"  # or "aruco"
     marker_radius_m: float | None = 0.03  # the disc's radius on the card; None: unknown
     reference_frames: int = 5
     min_area: int | None = None  # px; None: 1% of the image
@@ -152,7 +154,7 @@ class ServoConfig:
 @dataclass
 class LogRow:
     t: float  # s, capture time of the frame (left sensor)
-    phase: str
+    phase: Phase
     reason: str  # why the robot is stopped when it is ("" while it moves or holds)
     target_m: float
     depth_m: float  # the marker's depth, NaN when not seen (or not admitted)
@@ -176,7 +178,7 @@ class Step:
     disparity: np.ndarray | None  # the disparity computed this step (band or map), if any
     disparity_rows: tuple[int, int]  # the rows of the frame that disparity covers
     target: Target
-    marker: MarkerPair | None
+    marker_pair: MarkerPair | None
     row: LogRow
 
 
@@ -197,7 +199,7 @@ class Servo:
                  geometry: Geometry, control: ControlConfig = ControlConfig(),
                  config: ServoConfig | None = None,
                  clock: Callable[[], float] = time.monotonic, **overrides: Any) -> None:
-        """overrides: fields of ServoConfig (marker=, marker_radius_m=, full_map= ...)."""
+        """overrides: fields of ServoConfig (marker_kind=, marker_radius_m=, full_map= ...)."""
         self.cfg = dataclasses.replace(config or ServoConfig(), **overrides)
         self.source, self.link, self.params = source, link, params
         self.geometry, self.control, self.clock = geometry, control, clock
@@ -225,7 +227,7 @@ class Servo:
         self.flips = 0  # heading corrections by the motion check
         self._strips: StripMap | None = None  # the re-measure's map, a band per frame
         self._remeasure_t: float | None = None
-        self._cmd = Command(0, 0, "wait", None)  # the command in force
+        self._cmd = Command(0, 0, Phase.WAIT, None)  # the command in force
         self._statics: list[tuple[float, float]] = []  # where non-moving look-alikes stand
         self._width = 0
         self.recovery = Recovery(servo_bounds(self.cfg.recover, self.cfg.rereference,
@@ -270,14 +272,17 @@ class Servo:
         return StereoFrame(frame.left, match_exposure(frame.left, frame.right), frame.t_left,
                            frame.t_right)
 
+    # ------------------------------------------------------- the user's stop and the observers
+
     def request_stop(self, reason: str) -> None:
         """Stop the robot at the next frame (any thread may call this); that step's phase is
         "stop", and the caller's loop ends there."""
         self.requested_stop = self.stop_reason = reason
 
-    def _notify(self, frame: StereoFrame, phase: str, reason: str, disp: np.ndarray | None,
+    def _notify(self, frame: StereoFrame, phase: Phase, reason: str, disp: np.ndarray | None,
                 y0: int, pair: MarkerPair | None, row: LogRow | None,
                 rtt_ms: float = math.nan) -> None:
+        """Hand each observer this step's Snapshot (they return at once: snapshot.py)."""
         if self.observers:
             snap = Snapshot(self.clock(), phase, reason, frame.left, disp, y0, self.target, pair,
                             row, link_stats(self.link, rtt_ms), self.geometry)
@@ -293,7 +298,7 @@ class Servo:
             if i == 0:
                 self._reference_image = reference_image(f.left)
             disps.append(compute_disparity(f.left, f.right, self.params))
-            self._notify(f, "reference", "measuring the scene", disps[-1], 0, None, None)
+            self._notify(f, Phase.REFERENCE, "measuring the scene", disps[-1], 0, None, None)
             self.link.stop()  # the robot stands while it waits
         h, w = disps[0].shape
         min_area = self.cfg.min_area or (w * h) // 100
@@ -366,7 +371,7 @@ class Servo:
         for whole in (False, True):
             if whole and (self.last_pair is None or not seen.rejected):
                 break
-            candidates = marker_candidates(frame.left, frame.right, cfg.marker,
+            candidates = marker_candidates(frame.left, frame.right, cfg.marker_kind,
                                            cfg.marker_radius_m, g.baseline_m, self.last_pair,
                                            whole=whole)
             checked = 0
@@ -422,7 +427,7 @@ class Servo:
         if not (due or self._strips.busy):
             return
         robot_at = pair or self.last_pair
-        if self._cmd.phase in ("turn", "search", "find") or robot_at is None:
+        if self._cmd.phase in (Phase.TURN, Phase.SEARCH, Phase.FIND) or robot_at is None:
             self._strips.reset()
             return
         hide = self._robot_region(robot_at, frame.left.shape)
@@ -506,7 +511,7 @@ class Servo:
         if est.state is None or c is None or abs(est.state.z - c.target_m) >= c.cfg.block_m:
             return ""
         s = est.state
-        if not cmd.is_stop and cmd.phase in ("find", "search") and c.sweeps(s.z, s.x):
+        if not cmd.is_stop and cmd.phase in (Phase.FIND, Phase.SEARCH) and c.sweeps(s.z, s.x):
             return TURN_BLOCKED
         # unseen for a few frames (seen, the controller's hold watches the drift itself)
         if t - s.t > 0.1 and c.closing(s.x + s.vx * (t - s.t), s.vx, seen=False):
@@ -523,7 +528,7 @@ class Servo:
         if est.state is None or c is None:
             return ""
         z, x = est.state.z, est.state.x
-        toward = cmd.phase == "probe" or c.target_m < z
+        toward = cmd.phase == Phase.PROBE or c.target_m < z
         pair = self.last_pair
         if pair is not None:
             h, w = frame.left.shape[:2]
@@ -533,7 +538,7 @@ class Servo:
             if not in_view(pair.left.u, pair.left.v, pair.left.radius * self.cfg.ring_ratio,
                            (w, h), scale, g.cx, g.cy):
                 return "the marker would leave the view: the robot is at the picture's edge"
-        if cmd.phase == "probe":  # a sighting not yet trusted (maybe a look-alike standing
+        if cmd.phase == Phase.PROBE:  # a sighting not yet trusted (maybe a look-alike standing
             return ""  # in the reference, its own body a fixed object); the probe is short
         duty = abs(cmd.left + cmd.right) / 2
         speed = max(abs(est.state.vz), est.cfg.max_speed_mps * duty / 1000)
@@ -570,7 +575,7 @@ class Servo:
         if position is not None:
             noise_m = self.estimator.sigma_px * position[0] ** 2 / (
                 self.geometry.focal_px * self.geometry.baseline_m)
-            if acq.phase == "measure":  # probe the way the robot must go if it faces away
+            if acq.phase == Phase.MEASURE:  # probe the way the robot must go if it faces away
                 assert self.controller is not None
                 acq.direction = 1 if position[0] < self.controller.target_m else -1
         order = acq.update(t, position, None if position is None else d, noise_m)
@@ -585,10 +590,10 @@ class Servo:
             self.estimator.forget()
             self.last_pair = None
             self.acquisition = Acquisition(self.cfg.acquire)
-            return Command(0, 0, "find", None)
+            return Command(0, 0, Phase.FIND, None)
         if acq.fault:
             self.stop_reason = acq.fault
-        if before == "measure" and acq.phase != "measure":
+        if before == Phase.MEASURE and acq.phase != Phase.MEASURE:
             sd = acq.noise_px()
             self.estimator.sigma_px = max(0.05, sd)
             self._widen_tolerance(sd)
@@ -648,7 +653,7 @@ class Servo:
             self.estimator.reject(t, seen.rejected)
         waiting = self._waiting(frame, pair) if self.recovery.kind in (MOVED, RESET) else ""
         if waiting:  # the robot stands while a recovery is under way (recovery.py)
-            cmd = Command(0, 0, "recover", None)
+            cmd = Command(0, 0, Phase.RECOVER, None)
             invalid = invalid or waiting
         else:
             self._remeasure_band(frame, pair)
@@ -663,7 +668,7 @@ class Servo:
         if stalled and not self.stop_reason:  # STOP now: the run ends with this step
             self.stop_reason = stalled
             self.notes.append(f"{stalled}: {self.progress.detail()}")
-            cmd = Command(0, 0, "stop", cmd.error_m)
+            cmd = Command(0, 0, Phase.STOP, cmd.error_m)
         t_send = time.perf_counter()
         self._send(cmd, t)
         rtt_ms = (time.perf_counter() - t_send) * 1000
@@ -690,16 +695,16 @@ class Servo:
         """This frame's command from the acquisition or the controller."""
         assert self.controller is not None
         if self.stop_reason:  # read once: a STOP requested meanwhile acts next frame
-            return Command(0, 0, "stop", None)
+            return Command(0, 0, Phase.STOP, None)
         if not self.acquisition.done:
             if invalid:  # the measure or probe begins again after it (acquire.py)
                 self.acquisition.interrupted(t)
-                return Command(0, 0, "stale", None)
+                return Command(0, 0, Phase.STALE, None)
             cmd = self._acquire(t, position, d)
-            return Command(0, 0, "stop", None) if self.stop_reason else cmd
+            return Command(0, 0, Phase.STOP, None) if self.stop_reason else cmd
         self._check_motion(t, position is not None)
         if self._must_stop():  # the motion check may have ended the run
-            return Command(0, 0, "stop", None)
+            return Command(0, 0, Phase.STOP, None)
         depth, lateral = position if position is not None else (None, None)
         aspect = pair.left.aspect if pair is not None else 1.0
         cmd = self.controller.update(Observation(t, depth, lateral, aspect, invalid))
@@ -768,7 +773,7 @@ class Servo:
             old.facing_away
         c.fixed = old.fixed
         self.controller = c
-        self._cmd = Command(0, 0, "wait", None)
+        self._cmd = Command(0, 0, Phase.WAIT, None)
         self.notes.append(f"recovered ({why}): re-acquiring the robot")
 
     def _rereference_frame(self, frame: StereoFrame, pair: MarkerPair | None) -> bool:
@@ -880,12 +885,12 @@ class Servo:
         "obstacle") and waits (recovery.py's lane bound) until the lane has been clear a
         while; the controller learns that it stood (its creep floor must not rise)."""
         assert self.controller is not None
-        moving = not cmd.is_stop and cmd.phase in ("drive", "creep", "probe")
+        moving = not cmd.is_stop and cmd.phase in (Phase.DRIVE, Phase.CREEP, Phase.PROBE)
         fault = self._path_fault(frame, cmd) if moving else self._spin_fault(frame.t_left, cmd)
         if fault:  # nothing to wait for: the run ends here
             self.stop_reason = self.stop_reason or fault
-            self.controller.phase = "stop"
-            return Command(0, 0, "stop", cmd.error_m), invalid
+            self.controller.phase = Phase.STOP
+            return Command(0, 0, Phase.STOP, cmd.error_m), invalid
         blocked = self._lane_blocked(frame, cmd) if moving else ""
         rec = self.recovery
         if blocked:
@@ -896,7 +901,7 @@ class Servo:
             else:
                 self._recover(t, LANE, blocked)
         elif rec.kind == LANE:
-            if rec.update(t, moving or cmd.phase == "hold") == RESUME:
+            if rec.update(t, moving or cmd.phase == Phase.HOLD) == RESUME:
                 return cmd, invalid
             if rec.fault:
                 self.stop_reason = self.stop_reason or rec.fault
@@ -905,16 +910,16 @@ class Servo:
             return cmd, invalid
         if not moving:
             return cmd, invalid or blocked
-        self.controller.phase = "obstacle"
-        return Command(0, 0, "obstacle", cmd.error_m), invalid or blocked
+        self.controller.phase = Phase.OBSTACLE
+        return Command(0, 0, Phase.OBSTACLE, cmd.error_m), invalid or blocked
 
     def held_for(self, seconds: float) -> bool:
         """Whether the robot has been holding at the target for the last `seconds`."""
-        if not self.rows or self.rows[-1].phase != "hold":
+        if not self.rows or self.rows[-1].phase != Phase.HOLD:
             return False
         t_end = self.rows[-1].t
         for row in reversed(self.rows):
-            if row.phase != "hold":
+            if row.phase != Phase.HOLD:
                 return False
             if t_end - row.t >= seconds:
                 return True
@@ -931,7 +936,7 @@ def run_outcome(rows: list[LogRow]) -> tuple[str, str]:
     if not rows:
         return "stopped", "no frame"
     last = rows[-1]
-    if last.phase == "hold" and math.isfinite(last.depth_m):
+    if last.phase == Phase.HOLD and math.isfinite(last.depth_m):
         return "held", ""
     if not any(math.isfinite(r.robot_px) for r in rows):
         return "stopped", "the marker was never seen"

@@ -18,6 +18,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from host.servo.phase import Phase
+
 NO_PROGRESS = "no progress toward the target"
 
 
@@ -39,9 +41,9 @@ class Progress:
         self._hold_t0: float | None = None  # the hold without a break began then
         self._paused = 0.0  # time in bounded waits since the last progress
         self._last_t: float | None = None
-        self.last_phases: list[str] = []  # the phases since the last progress, in order
+        self.last_phases: list[Phase] = []  # the phases since the last progress, in order
 
-    def update(self, t: float, phase: str, error_m: float | None, target_m: float,
+    def update(self, t: float, phase: Phase, error_m: float | None, target_m: float,
                waiting: bool = False) -> str:
         """The frame at t: its phase, the depth error (m, None when not measured), the
         target's depth; waiting: a wait recovery.py bounds. Returns why the run must end, or
@@ -56,7 +58,7 @@ class Progress:
             self._progress(t)
         if waiting:
             self._paused += dt
-        if phase == "hold":
+        if phase == Phase.HOLD:
             self._hold_t0 = t if self._hold_t0 is None else self._hold_t0
             if t - self._hold_t0 >= cfg.hold_s:
                 self._progress(t)

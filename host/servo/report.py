@@ -11,6 +11,7 @@ from dataclasses import asdict, fields
 from host.camera.geometry import Geometry
 from host.files import write_bytes_atomic, write_text_atomic
 from host.servo.loop import LogRow
+from host.servo.phase import Phase
 
 
 def write_csv(path: str | os.PathLike[str], rows: list[LogRow]) -> None:
@@ -46,8 +47,8 @@ def plot_run(path: str | os.PathLike[str], rows: list[LogRow], geometry: Geometr
                   f"{rows[-1].target_m:.3f} m")
     ax2.plot(t, [r.left for r in rows], label="left duty")
     ax2.plot(t, [r.right for r in rows], label="right duty")
-    for phase, colour in (("turn", "tab:orange"), ("hold", "tab:green"), ("lost", "tab:red"),
-                          ("stale", "tab:purple")):
+    for phase, colour in ((Phase.TURN, "tab:orange"), (Phase.HOLD, "tab:green"),
+                          (Phase.LOST, "tab:red"), (Phase.STALE, "tab:purple")):
         on = [r.phase == phase for r in rows]
         ax2.fill_between(t, -1000, 1000, where=on, color=colour, alpha=0.12, step="mid",
                          label=phase)

@@ -16,6 +16,7 @@ from host.camera.geometry import Geometry
 from host.link import protocol_gen as gen
 from host.servo.marker import MarkerPair
 from host.servo.perception import Target
+from host.servo.phase import Phase
 
 
 @dataclass(frozen=True)
@@ -36,13 +37,14 @@ class Snapshot:
     """One step: the rectified left image, the disparity the step computed, what was found."""
 
     t: float  # s, the loop's clock
-    phase: str  # reference, then the LogRow phases (measure, drive, creep, hold, turn, stop ...)
+    phase: Phase  # reference, then the LogRow phases (measure, drive, hold, turn, stop ...);
+    # view: `host view`, no robot; ended: the view's last picture after the run
     reason: str  # why the robot is stopped ("" while it may move)
     left: np.ndarray  # rectified left image, uint8 BGR or grey
     disparity: np.ndarray | None  # px, NaN = invalid; rows disparity_y0.. of the image
     disparity_y0: int  # the full map (0) or a band of rows over the marker
     target: Target | None
-    marker: MarkerPair | None  # the marker seen in both views (None: not seen)
+    marker_pair: MarkerPair | None  # the marker seen in both views (None: not seen)
     row: Any  # the step's LogRow (None in the reference phase)
     link: LinkStats | None
     geometry: Geometry

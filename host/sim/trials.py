@@ -32,6 +32,7 @@ from host.link import protocol_gen as gen
 from host.link.client import LinkError
 from host.servo.controller import ControlConfig
 from host.servo.loop import LogRow
+from host.servo.phase import Phase
 from host.servo_run import HELD, NOT_SETTLED, UNSAFE, Rules, run_servo
 from host.sim.faults import WorldFaults, random_faults
 from host.sim.run import Setup, SimRun, simulation
@@ -158,7 +159,7 @@ class Judge:
         if math.isfinite(row.depth_m) and not row.reason:
             self.last_valid = row.t
         r = self.sim.world.robot
-        if row.phase == "probe":
+        if row.phase == Phase.PROBE:
             self.probe_from = self.probe_from or (r.x_m, r.z_m)
             travel = math.hypot(r.x_m - self.probe_from[0], r.z_m - self.probe_from[1])
             if travel > PROBE_TRAVEL_M:
@@ -211,7 +212,7 @@ def run_trial(job: tuple[int, int, tuple[int, int], MatcherParams, bool]) -> Tri
         if outcome in ("held", "missed"):
             rows = servo.rows
             k = len(rows) - 1
-            while k > 0 and rows[k - 1].phase == "hold":
+            while k > 0 and rows[k - 1].phase == Phase.HOLD:
                 k -= 1
             t_hold = rows[k].t - rows[0].t
         return Trial(index, setup.start_z_m, target0, _describe(setup.faults),

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from host.servo.phase import Phase
 from host.servo.snapshot import Snapshot
 from host.view import render
 
@@ -74,7 +75,7 @@ class ViewFeed:
             disp = snap.disparity
             if disp is not None and snap.disparity_y0 == 0 and disp.shape == snap.left.shape[:2]:
                 self._full_map = disp
-            if snap.row is not None or snap.phase in ("view", "ended"):
+            if snap.row is not None or snap.phase in (Phase.VIEW, Phase.ENDED):
                 self._sample(snap)
             self._cond.notify_all()
 
@@ -87,7 +88,7 @@ class ViewFeed:
             duty: tuple[int | None, int | None] = (int(row.left), int(row.right))
         else:
             target_px = snap.target.disparity if snap.target is not None else math.nan
-            robot_px = snap.marker.disparity if snap.marker is not None else math.nan
+            robot_px = snap.marker_pair.disparity if snap.marker_pair is not None else math.nan
             duty = (None, None)
         target = g.depth_m(target_px) if target_px > 0 else None  # NaN > 0 is False
         robot = g.depth_m(robot_px) if robot_px > 0 else None
@@ -132,7 +133,7 @@ class ViewFeed:
         with self._cond:
             snap = self._latest
         if snap is not None:
-            self(dataclasses.replace(snap, phase="ended", reason=reason))
+            self(dataclasses.replace(snap, phase=Phase.ENDED, reason=reason))
 
     @property
     def latest_seq(self) -> int:

@@ -83,12 +83,12 @@ def overlay(snap: Snapshot) -> dict[str, Any]:
         x, y, w, h = snap.target.bbox
         out["target"] = {"x": x, "y": y, "w": w, "h": h, "px": _num(snap.target.disparity),
                          "m": _num(_depth(g, snap.target.disparity), 3)}
-    if snap.marker is not None:
-        left, right = snap.marker.left, snap.marker.right
+    if snap.marker_pair is not None:
+        left, right = snap.marker_pair.left, snap.marker_pair.right
         out["marker"] = {"left": [_num(left.u, 1), _num(left.v, 1), _num(left.radius, 1)],
                          "right": [_num(right.u, 1), _num(right.v, 1), _num(right.radius, 1)],
-                         "px": _num(snap.marker.disparity),
-                         "m": _num(_depth(g, snap.marker.disparity), 3)}
+                         "px": _num(snap.marker_pair.disparity),
+                         "m": _num(_depth(g, snap.marker_pair.disparity), 3)}
     return out
 
 

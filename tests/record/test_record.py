@@ -109,10 +109,10 @@ def test_every_topic_decodes_as_the_run_saw_it(run, read):
     assert [s.message for s in drives] == [f"{s.row.left} {s.row.right}" for s in snaps
                                            if s.row is not None]
     # the marker where the run saw it, the target at its depth
-    markers = [s for s in snaps if s.marker is not None]
+    markers = [s for s in snaps if s.marker_pair is not None]
     assert len(topics["/servo/marker"]) == len(markers) > 0
     z = topics["/servo/marker"][-1][1].point.z
-    assert z == pytest.approx(snap.geometry.depth_m(markers[-1].marker.disparity))
+    assert z == pytest.approx(snap.geometry.depth_m(markers[-1].marker_pair.disparity))
     target = topics["/servo/target"][-1][1].point.z
     assert target == pytest.approx(snaps[-1].geometry.depth_m(snaps[-1].target.disparity))
     assert math.isfinite(target)

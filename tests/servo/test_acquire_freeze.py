@@ -7,7 +7,8 @@ from __future__ import annotations
 
 import pytest
 
-from host.servo.acquire import MEASURE, PROBE, AcquireConfig, Acquisition
+from host.servo.acquire import AcquireConfig, Acquisition
+from host.servo.phase import Phase
 from host.sim.faults import Event, WorldFaults
 from host.sim.run import Setup, simulation
 
@@ -15,7 +16,7 @@ from host.sim.run import Setup, simulation
 def test_an_interrupted_probe_begins_again_and_finds_the_heading() -> None:
     acq = Acquisition(AcquireConfig())
     t = 0.0
-    while acq.phase != PROBE:  # find and measure, standing at 1.2 m
+    while acq.phase != Phase.PROBE:  # find and measure, standing at 1.2 m
         t += 0.033
         acq.update(t, (1.2, 0.0), 20.0)
     for _ in range(3):  # the probe begins, then a sensor freezes for 2.5 s
@@ -25,7 +26,7 @@ def test_an_interrupted_probe_begins_again_and_finds_the_heading() -> None:
         t += 0.033
         acq.interrupted(t)
     z = 1.2
-    while acq.phase == PROBE and t < 8.0:  # usable again: the probe moves the robot away
+    while acq.phase == Phase.PROBE and t < 8.0:  # usable again: the probe moves the robot away
         t += 0.033
         order = acq.update(t, (z, 0.0), 20.0)
         z += 0.002 if order.left > 0 else 0.0
@@ -35,7 +36,7 @@ def test_an_interrupted_probe_begins_again_and_finds_the_heading() -> None:
 def test_an_interrupted_measure_begins_again() -> None:
     acq = Acquisition(AcquireConfig())
     acq.update(0.0, (1.2, 0.0), 20.0)
-    assert acq.phase == MEASURE
+    assert acq.phase == Phase.MEASURE
     for i in range(5):
         acq.update(0.03 * (i + 1), (1.2, 0.0), 20.0 + 5 * (i % 2))  # a frozen view's jumps
     acq.interrupted(0.2)
@@ -64,6 +65,6 @@ def test_a_marker_gone_before_the_measure_is_done_is_found_again() -> None:
     acq = Acquisition(AcquireConfig())
     acq.update(0.0, (1.9, 0.0), 13.0)
     acq.update(0.033, (1.9, 0.0), 13.0)
-    assert acq.phase == MEASURE
+    assert acq.phase == Phase.MEASURE
     orders = [acq.update(0.033 * i, None, None) for i in range(2, 150)]
     assert any(o.phase == "find" and o.left == -o.right != 0 for o in orders)

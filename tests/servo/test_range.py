@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import pytest
 
+from host.servo.phase import Phase
 from host.sim.faults import WorldFaults
 from host.sim.run import Setup, simulation
 from host.stereo import MatcherParams
@@ -41,7 +42,7 @@ def test_a_run_that_never_sees_the_marker_is_not_held() -> None:
         outcome, reason = sim.servo.outcome()
         assert outcome == "stopped" and "never seen" in reason
         assert sim.servo.stop_reason == "the marker was never seen"
-        assert {r.phase for r in sim.servo.rows} <= {"wait", "find", "stop"}
+        assert {r.phase for r in sim.servo.rows} <= {Phase.WAIT, Phase.FIND, Phase.STOP}
         assert abs(sim.world.robot.z_m - 0.9) < 0.01  # in place
         sim.run(sim.source.t + 0.5)
         assert sim.emulator.motors() == (0, 0)

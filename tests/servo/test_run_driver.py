@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
+from host.servo.phase import Phase
 from host.servo_run import STOPPED, Rules, run_servo
 
 
@@ -16,9 +17,9 @@ class RacedServo:
         self.stop_reason, self.sent = "", []
 
     def step(self, truth: float) -> SimpleNamespace:
-        phase = "stop" if self.stop_reason else "drive"
+        phase = Phase.STOP if self.stop_reason else Phase.DRIVE
         self.sent.append(phase)
-        if phase == "drive":
+        if phase == Phase.DRIVE:
             self.stop_reason = "STOP pressed in the view"  # arrives while the drive goes out
         return SimpleNamespace(phase=phase, t=len(self.sent) * 0.033, reason=self.stop_reason)
 
@@ -30,4 +31,4 @@ def test_a_stop_requested_during_a_drive_ends_the_run_after_the_stop_is_sent() -
     servo = RacedServo()
     end = run_servo(servo, Rules(settle_s=0), clock=lambda: 0.0)
     assert (end.how, end.reason) == (STOPPED, "STOP pressed in the view")
-    assert servo.sent == ["drive", "stop"]  # the run did not end with the drive the last word
+    assert servo.sent == [Phase.DRIVE, Phase.STOP]  # the drive was not the last word

@@ -18,6 +18,7 @@ from types import SimpleNamespace
 import pytest
 
 from host.servo.loop import LogRow
+from host.servo.phase import Phase
 from host.sim.campaign import run_trials
 from host.sim.trial_stats import summary, upper_bound, wilson
 from host.sim.trials import Judge, Trial, _unsafe
@@ -47,7 +48,7 @@ def test_unsafe_outcomes_are_named() -> None:
 
 def row(depth: float, truth: float, duty: int = 300, reason: str = "") -> LogRow:
     nan = math.nan
-    return LogRow(5.0, "drive", reason, 1.2, depth, nan, 20.0, 20.0, nan, duty, duty, 30.0, 1.0,
+    return LogRow(5.0, Phase.DRIVE, reason, 1.2, depth, nan, 20.0, 20.0, nan, duty, duty, 30.0, 1.0,
                   0.0, truth)
 
 
@@ -67,7 +68,7 @@ def test_a_probe_move_is_judged_by_its_travel_not_by_the_sighting_it_tests() -> 
     sim = sim_with(1.79)
     judge = Judge(sim)
     probe = row(1.43, 1.79)
-    probe.phase = "probe"
+    probe.phase = Phase.PROBE
     assert judge(probe) == ""  # the decoy at 1.43 m tested, the robot at 1.79 m
     sim.world.robot.z_m = 1.79 - 0.10
     assert judge(probe) == ""  # 10 cm: within the bound
@@ -77,7 +78,7 @@ def test_a_probe_move_is_judged_by_its_travel_not_by_the_sighting_it_tests() -> 
     # a probe is no exemption from the stale limit: driving 0.5 s past the last sighting
     blind = Judge(sim_with(1.79, t=5.5))
     unseen = row(math.nan, 1.79)
-    unseen.phase = "probe"
+    unseen.phase = Phase.PROBE
     assert "without a valid observation" in blind(unseen)
 
 

@@ -8,12 +8,13 @@ from host.camera.geometry import Geometry
 from host.servo.loop import LogRow
 from host.servo.marker import Blob, MarkerPair
 from host.servo.perception import Target
+from host.servo.phase import Phase
 from host.servo.snapshot import LinkStats, Snapshot
 
 GEOMETRY = Geometry.minoru_default(320, 240)
 
 
-def snapshot(t: float = 1.0, robot_px: float = 20.0, phase: str = "drive") -> Snapshot:
+def snapshot(t: float = 1.0, robot_px: float = 20.0, phase: Phase = Phase.DRIVE) -> Snapshot:
     left = np.full((240, 320, 3), 90, np.uint8)
     disp = np.full((240, 320), 12.0, np.float32)
     disp[:, :20] = np.nan  # the left border has no disparity
