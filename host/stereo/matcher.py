@@ -63,7 +63,8 @@ def _planes(image: np.ndarray, colour: bool, view: bool = False) -> np.ndarray:
 
 
 def own_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.ndarray:
-    """The paper's block matcher (SAD, or SSD / ZNCC) with WTA, sub-pixel and LR check.
+    """The project's own matchers: the paper's block matcher (SAD, or SSD / ZNCC) with WTA,
+    sub-pixel and LR check, or census + semi-global matching (SGM, host/stereo/sgm.py).
 
     SAD and SSD sum the cost over the colour channels when p.colour is set; NCC uses grey.
     """
