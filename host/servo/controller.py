@@ -207,9 +207,10 @@ class Controller:
 
     def sweeps(self, depth_m: float, lateral_m: float | None) -> bool:
         """Whether a turn in place here sweeps the body (a circle of turn_radius_m) within
-        block_margin_m of the object's extent or of a fixed object's cell in its path (the
-        background's cells, behind the robot, are not: far away their depth is noisy; nor
-        those inside its own body: the sighting is then of a look-alike standing there)."""
+        block_margin_m of the object's extent or of any other fixed object's cell, behind the
+        robot as well as ahead (a turn sweeps the whole circle: a box a few cm farther than the
+        robot's centre is as near as one in its path), but not those inside its own body (the
+        sighting is then of a look-alike standing there)."""
         if lateral_m is None:
             return False
         cfg = self.cfg
@@ -217,7 +218,7 @@ class Controller:
         if abs(depth_m - self.target_m) < reach and self.overlaps(
                 lateral_m, reach - cfg.half_width_m):
             return True
-        cells = self.ahead(depth_m)
+        cells = self.others()
         dz, dx = cells[:, 0] - depth_m, cells[:, 1] - lateral_m
         own = (np.abs(dz) < 0.06) & (np.abs(dx) < cfg.half_width_m)  # a look-alike's body
         return bool(((np.hypot(dz, dx) < reach + cfg.cell_m / 2) & ~own).any())

@@ -228,3 +228,21 @@ def test_a_look_alike_where_the_robot_stands_does_not_block_its_turn() -> None:
     beside.fixed = np.array([[1.49, 0.11]])
     cmd = beside.update(Observation(0.0, 1.5, 0.0))  # no turn: it reverses instead
     assert cmd.phase == "drive" and cmd.left < 0 and cmd.right < 0 and not beside.fault
+
+
+def test_a_turn_is_not_started_where_it_would_sweep_a_box_just_behind_the_robot() -> None:
+    """The circle a turn in place sweeps lies behind the robot's centre as much as ahead: a
+    robot 4 cm nearer the camera than a box's face at 1.8 m (0.22-0.55 m), its centre 9 cm
+    from the box's corner, does not turn there (the check once took only the cells between
+    the robot and the target, and a robot turned into such a corner); 30 cm nearer it does."""
+    def controller() -> Controller:
+        ctl = Controller(1.34, ControlConfig())
+        ctl.keep_out = BOX
+        ctl.fixed = _face(1.8, 0.22, 0.55)
+        return ctl
+    near_box = controller()
+    assert near_box.sweeps(1.76, 0.125)
+    cmd = near_box.update(Observation(0.0, 1.76, 0.125))
+    assert cmd.phase != "turn" and not (cmd.left * cmd.right < 0), cmd
+    assert not controller().sweeps(1.50, 0.125)
+    assert controller().update(Observation(0.0, 1.50, 0.125)).phase == "turn"
