@@ -10,27 +10,31 @@ DATA ?= $(abspath ../shared/data)
 # tests and benchmarks find the Middlebury scenes through this variable
 export STEREO_SERVO_DATA ?= $(if $(wildcard $(DATA)/middlebury/index.json),$(DATA),)
 
-.PHONY: demo test lint typecheck bench venv system-deps browser-deps platformio protocol firmware flash mutants fuzz clean
+.PHONY: demo test test-setup lint typecheck bench venv system-deps browser-deps platformio protocol firmware flash mutants fuzz clean
 
 $(BIN)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --disable-pip-version-check -e '.[test,ray]'
-	$(BIN)/python -m host.stereo.warm  # numba compiles now (2 processes), not in the user's first run
 	touch $@
 
-venv: $(BIN)/.installed
+# numba compiles now (2 processes), not in the user's first run
+$(BIN)/.warmed: $(BIN)/.installed
+	$(BIN)/python -m host.stereo.warm
+	touch $@
+
+venv: $(BIN)/.warmed
 
 system-deps:
 	@bash tools/system-deps.sh
 
 # Debian's chromium for the live view's browser test (tests/view)
-browser-deps:
+browser-deps: system-deps
 	@bash tools/browser-deps.sh
 
 # PlatformIO Core in .venv and its atmelavr platform from Debian and PyPI, under build/platformio
 # (tools/platformio-offline.sh); exit 3 = no ../shared/platformio here, and the tests skip
 PIO_CORE := $(abspath build/platformio)
-platformio: venv system-deps
+platformio: $(BIN)/.installed system-deps
 	@bash tools/platformio-offline.sh || [ $$? -eq 3 ]
 
 demo: venv
@@ -44,14 +48,19 @@ demo: venv
 # pytest-xdist: TEST_WORKERS processes, each test file whole on one of them (tests/conftest.py
 # says what files share and how that is kept safe); TEST_WORKERS=0 runs in this process
 TEST_WORKERS ?= 2
-test: venv system-deps browser-deps platformio lint typecheck
+# the set-up in two jobs: the warm step's compiling (CPU) beside the installs (network, disk)
+# and the checks; make test-setup alone runs them one after the other
+test:
+	$(MAKE) -j2 test-setup
 	$(BIN)/python -m pytest -n $(TEST_WORKERS) --dist loadfile --durations=20
 
-lint: venv
+test-setup: venv system-deps browser-deps platformio lint typecheck
+
+lint: $(BIN)/.installed
 	$(BIN)/ruff check host tools bench tests
 
 # mypy, strict on host/ as pyproject.toml's [tool.mypy] configures it (relaxations said there)
-typecheck: venv
+typecheck: $(BIN)/.installed
 	$(BIN)/mypy
 
 bench: venv
