@@ -67,13 +67,7 @@ def pack(disp: np.ndarray) -> np.ndarray:
 
 
 def main() -> int:
-    out = {}
-    for i, config in enumerate(CONFIGS):
-        left, right = run(config)
-        out[f"left{i}"], out[f"right{i}"] = pack(left), pack(right)
-    np.savez_compressed(FILE, **out)
-    print(f"{FILE}: {len(CONFIGS)} configurations", file=sys.stderr)
-    return 0
+    return sgm_reference.freeze(FILE, CONFIGS, run, pack)
 
 
 if __name__ == "__main__":

@@ -10,7 +10,9 @@ aggregation (sgm.match) to its outputs whatever the cost side does.
 from __future__ import annotations
 
 import sys
+from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -119,14 +121,21 @@ def unpack(stored: np.ndarray) -> np.ndarray:
     return stored
 
 
-def main() -> int:
+def freeze(file: Any, configs: Sequence[Any],
+           run: Callable[[Any], tuple[np.ndarray, np.ndarray]],
+           pack: Callable[[np.ndarray], np.ndarray]) -> int:
+    """Each configuration's left and right maps, packed, into file (an .npz): the reference."""
     out = {}
-    for i, config in enumerate(CONFIGS):
+    for i, config in enumerate(configs):
         left, right = run(config)
         out[f"left{i}"], out[f"right{i}"] = pack(left), pack(right)
-    np.savez_compressed(FILE, **out)
-    print(f"{FILE}: {len(CONFIGS)} configurations", file=sys.stderr)
+    np.savez_compressed(file, **out)
+    print(f"{file}: {len(configs)} configurations", file=sys.stderr)
     return 0
+
+
+def main() -> int:
+    return freeze(FILE, CONFIGS, run, pack)
 
 
 if __name__ == "__main__":
