@@ -200,6 +200,8 @@ ROWS = [
     (SERVO + ["--min-duty", "-100"], "argument --min-duty: must be >= 0"),
     (SERVO + ["--min-duty", "700"], "--min-duty 700 exceeds --max-duty 600"),
     (["servo", "--sim", "--trial-index", "3"], "--trial-index goes with --trials N"),
+    (["servo", "--sim", "--marker-radius-cm", "4"], "the simulated world draws its own"),
+    (["servo", "--sim", "--marker", "aruco"], "the simulated world draws its own"),
     (["servo", "--sim", "--nominal", "--json", "{tmp}/t.json"], "--json goes with --trials N"),
     (["servo", "--sim", "--trials", "3", "--log", "{tmp}/run.csv"],
      "--log writes one run's log: not with --trials"),

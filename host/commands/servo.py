@@ -175,6 +175,9 @@ def run(args: argparse.Namespace) -> int:
     if args.trials:
         _check_trial_args(args)
     if args.sim or args.camera == "sim":
+        if args.marker_kind != "disc" or args.marker_radius_cm != 3.0:
+            raise HostError("--marker and --marker-radius-cm describe the real robot's card: "
+                            "the simulated world draws its own (a 3 cm disc)")
         if args.port not in (None, "emulator"):
             raise HostError("--camera sim needs --port emulator (the simulated robot)")
         return _run_sim(args)
