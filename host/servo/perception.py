@@ -89,6 +89,13 @@ class Target:
     spread: float  # px, interquartile range of the region's disparity
 
 
+def span_overlap(a0: float, a1: float, b0: float, b1: float) -> float:
+    """The overlap of intervals [a0, a1) and [b0, b1) as a share of the narrower (0 when
+    either is empty): two regions' columns or rows, the same object when it is large."""
+    narrower = min(a1 - a0, b1 - b0)
+    return max(0.0, min(a1, b1) - max(a0, b0)) / narrower if narrower > 0 else 0.0
+
+
 def nearest_object(disp: np.ndarray, min_area: int, step: float = 0.5,
                    near: float | None = None) -> Target:
     """The connected region of largest disparity with at least min_area pixels.

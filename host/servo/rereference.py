@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from host.servo.perception import Floor, Target
+from host.servo.perception import Floor, Target, span_overlap
 from host.stereo.grey import to_grey
 
 
@@ -77,12 +77,6 @@ class RereferenceLimits:
     disparity_frac: float = 0.03
     overlap: float = 0.5
     agreement: float = 0.6
-
-
-def _overlap(a0: float, a1: float, b0: float, b1: float) -> float:
-    """The overlap of intervals [a0, a1) and [b0, b1) as a share of the narrower."""
-    narrower = min(a1 - a0, b1 - b0)
-    return max(0.0, min(a1, b1) - max(a0, b0)) / narrower if narrower > 0 else 0.0
 
 
 def target_shift_rows(reference: np.ndarray, image: np.ndarray, box: tuple[int, int, int, int],
@@ -142,8 +136,8 @@ def rereference_fault(old_floor: Floor | None, floor: Floor, shift_rows: float, 
                 f"{old.disparity:.2f} px")
     ox, oy, ow, oh = old.bbox
     nx, ny, nw, nh = new.bbox
-    across = _overlap(ox, ox + ow, nx, nx + nw)
-    down = _overlap(oy + shift_rows, oy + oh + shift_rows, ny, ny + nh)
+    across = span_overlap(ox, ox + ow, nx, nx + nw)
+    down = span_overlap(oy + shift_rows, oy + oh + shift_rows, ny, ny + nh)
     if across < lim.overlap or down < lim.overlap:
         return (f"the nearest object is not where the target was: ({nx}, {ny}) {nw}x{nh} px "
                 f"for ({ox}, {oy + shift_rows:.0f}) {ow}x{oh}")

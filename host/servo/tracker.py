@@ -17,7 +17,7 @@ import numpy as np
 
 from host.errors import HostError
 from host.servo.inputs import NearerObject
-from host.servo.perception import Target, nearest_object
+from host.servo.perception import Target, nearest_object, span_overlap
 
 VANISHED = "target vanished"
 
@@ -61,8 +61,8 @@ class TargetTracker:
             found: Target | None = nearest_object(disp, self.min_area, near=old.disparity)
         except HostError:
             found = None
-        overlap = found is not None and min(bx + bw, found.bbox[0] + found.bbox[2]) - max(
-            bx, found.bbox[0]) > self.cfg.overlap * min(bw, found.bbox[2])
+        overlap = found is not None and span_overlap(
+            bx, bx + bw, found.bbox[0], found.bbox[0] + found.bbox[2]) > self.cfg.overlap
         if overlap and found is not None and (
                 found.bbox[2] > self.cfg.object_width * disp.shape[1]
                 or abs(found.disparity - old.disparity) > self.cfg.same_depth * old.disparity):
