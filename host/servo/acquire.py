@@ -85,8 +85,7 @@ class Acquisition:
                 self.disparities.append(disparity)
                 if len(self.disparities) >= self.cfg.noise_frames:
                     self._begin(Phase.PROBE if self.probes else Phase.DONE, t)
-            elif t - max(t if self._t0 is None else self._t0, self._seen_t) > \
-                    self.cfg.find_wait_s:
+            elif t - max(self._t0, self._seen_t) > self.cfg.find_wait_s:
                 # gone again before the measure was done (seen edge-on at the end of a turn,
                 # a glimpse): find it again, spinning if need be, rather than wait for ever
                 self.disparities.clear()
