@@ -425,12 +425,7 @@ def _sweep(cl, crrev, gl, gr, vol, pl, prrev, term, S, C, P, M, crow, tot, forwa
     nd = S.shape[2]
     cs = _census_scratch(gl, dmin, nd)
     step = 1 if forward else -1
-    idx = np.arange(nd + 1).astype(np.uint16)
-    jj = np.arange(nd + 1).astype(np.uint32)
-    fb = np.empty((4, w), dtype=np.float32)
-    mins = np.empty(w, dtype=np.uint16)
-    Z = np.zeros(nd + 2, dtype=np.uint16)
-    rr = np.full(w, np.nan, dtype=np.float32)
+    idx, jj, fb, mins, Z, _, rr = _row_scratch(w, nd)
     reuse = C.shape[0] > 0
     for i in range(i0, i1):
         y = i if forward else h - 1 - i
