@@ -74,9 +74,9 @@ def load_params(path: str | os.PathLike[str]) -> tuple[MatcherParams, dict[str, 
     if "matcher" not in data:
         raise HostError(f"{p}: no [matcher] table")
     for key in data["matcher"]:
-        if key.replace("-", "_") in PARAMETERS:  # never a key of a written file: the CLI's
-            raise HostError(f"{p}: [matcher] key {key} is {PARAMETERS[key.replace('-', '_')]} "
-                            f"in a params file")
+        field = PARAMETERS.get(key.replace("-", "_"))
+        if field:  # never a key of a written file: the CLI's
+            raise HostError(f"{p}: [matcher] key {key} is {field} in a params file")
     tuning = data.get("tuning", {})
     if isinstance(tuning, dict) and tuning.get("space") in SPACES:
         new = SPACES[tuning["space"]]
