@@ -10,13 +10,10 @@ compiling is single-threaded, and the two 4-path SGM signatures alone take most 
 from __future__ import annotations
 
 import argparse
-import fcntl
 import os
 import subprocess
 import sys
 import time
-from collections.abc import Callable
-from typing import Any
 
 import numpy as np
 
@@ -58,31 +55,6 @@ def warm(part: int = 0, parts: int = 1) -> int:
     return len(ps)
 
 
-def lock_cache_files() -> None:
-    """Make numba's cache updates safe between processes compiling at once (the warm step's
-    parts, pytest's workers). numba's IndexDataCacheFile.save reads a function's index, adds
-    its new signature with the first free data file number and writes both back; two processes
-    adding different signatures of one function at once can both take number 1, and the index
-    then names the other signature's machine code. Each save and load here holds an exclusive
-    lock on a file beside the function's index for its read-modify-write."""
-    from numba.core import caching
-
-    cls: Any = caching.IndexDataCacheFile
-    if getattr(cls, "locked_by_stereo_servo", False):
-        return
-
-    def locked(fn: Callable[..., Any]) -> Callable[..., Any]:
-        def run(self: Any, *args: Any) -> Any:
-            os.makedirs(self._cache_path, exist_ok=True)
-            with open(self._index_path + ".lock", "a") as f:
-                fcntl.flock(f, fcntl.LOCK_EX)
-                return fn(self, *args)
-        return run
-
-    cls.save, cls.load = locked(cls.save), locked(cls.load)
-    cls.locked_by_stereo_servo = True
-
-
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m host.stereo.warm", description=__doc__)
     ap.add_argument("--processes", type=int, default=min(2, os.cpu_count() or 1),
@@ -92,7 +64,6 @@ def main(argv: list[str] | None = None) -> int:
     if args.processes < 1:
         print(f"--processes must be at least 1, got {args.processes}", file=sys.stderr)
         return 2
-    lock_cache_files()
     t0 = time.perf_counter()
     if args.part is not None:  # one of the processes below
         warm(args.part, args.processes)
