@@ -170,7 +170,7 @@ def pytest_sessionstart(session) -> None:
 
 class _NumbaCompiles(event.Listener):
     """Records the numba kernels compiled (not loaded from the cache) during each test: the
-    warm step (python -m host.stereo.warm) should have compiled them, and compiling costs a
+    warm step (python -m host.warm) should have compiled them, and compiling costs a
     test tens of seconds."""
 
     def __init__(self) -> None:

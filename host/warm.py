@@ -1,10 +1,12 @@
 """Compile every numba kernel signature users hit into numba's cache (run at installation).
 
-`python -m host.stereo.warm` (the Makefile's venv step runs it) calls each own matcher on a
-small random pair with every lane width, channel count and option that selects a different
-compiled signature, so the first `host eval` loads machine code instead of compiling it.
-The variants are shared among `--processes` processes (default: one per core, at most 2):
-compiling is single-threaded, and the two 4-path SGM signatures alone take most of the time.
+`python -m host.warm` (the Makefile's venv step runs it) calls each own matcher on a small
+random pair with every lane width, channel count and option that selects a different compiled
+signature, and the self-supervised tuner's census and terms (host tune --objective self), so
+the first `host eval` or `host tune` loads machine code instead of compiling it. The jobs are
+shared among `--processes` processes (default: one per core, at most 2): compiling is
+single-threaded, and the two 4-path SGM signatures alone take most of the time. It sits above
+host.stereo and host.tuning, whose kernels it compiles.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ import numpy as np
 
 from host.stereo.matcher import compute_disparity
 from host.stereo.params import MatcherParams
+from host.tuning.self_supervised import terms_of_maps
 
 
 def variants() -> list[MatcherParams]:
@@ -42,9 +45,18 @@ def variants() -> list[MatcherParams]:
     return out
 
 
+def _tuner(rng: np.random.Generator) -> None:
+    """The self-supervised objective's kernels (census, terms) on a pair and a map of the
+    dtypes its score passes (uint8 BGR pair, float32 map with NaN where no disparity)."""
+    left = rng.integers(0, 256, (40, 96, 3), dtype=np.uint8)
+    disp = np.full(left.shape[:2], 3.0, np.float32)
+    disp[:, :8] = np.nan
+    terms_of_maps(left, np.roll(left, -3, axis=1), disp)
+
+
 def warm(part: int = 0, parts: int = 1) -> int:
-    """Run every parts-th variant from part on once on a small random colour pair; returns how
-    many ran."""
+    """Run every parts-th matcher variant from part on once on a small random colour pair, and
+    in the last part the tuner's kernels; returns how many jobs ran."""
     rng = np.random.default_rng(0)
     ps = variants()[part::parts]
     for p in ps:
@@ -52,11 +64,13 @@ def warm(part: int = 0, parts: int = 1) -> int:
         left = rng.integers(0, 256, size, dtype=np.uint8)
         right = np.roll(left, -3, axis=1)
         compute_disparity(left, right, p.replace(num_disparities=16))
-    return len(ps)
+    if part == parts - 1:
+        _tuner(rng)
+    return len(ps) + (part == parts - 1)
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m host.stereo.warm", description=__doc__)
+    ap = argparse.ArgumentParser(prog="python -m host.warm", description=__doc__)
     ap.add_argument("--processes", type=int, default=min(2, os.cpu_count() or 1),
                     help="processes compiling at once (default: cores, at most 2)")
     ap.add_argument("--part", type=int, default=None, help=argparse.SUPPRESS)
@@ -71,14 +85,15 @@ def main(argv: list[str] | None = None) -> int:
     if args.processes == 1:
         n = warm()
     else:
-        parts = [subprocess.Popen([sys.executable, "-m", "host.stereo.warm", "--processes",
+        parts = [subprocess.Popen([sys.executable, "-m", "host.warm", "--processes",
                                    str(args.processes), "--part", str(k)])
                  for k in range(args.processes)]
         if any(p.wait() for p in parts):
             print("a warm-up process failed (above)", file=sys.stderr)
             return 1
-        n = len(variants())
-    print(f"numba kernels compiled or loaded from cache: {n} matcher variants in "
+        n = len(variants()) + 1
+    print(f"numba kernels compiled or loaded from cache: {n} jobs (matcher variants, the "
+          f"self-supervised tuner) in "
           f"{args.processes} processes, {time.perf_counter() - t0:.1f} s", file=sys.stderr)
     return 0
 
