@@ -41,7 +41,10 @@ def variants() -> list[MatcherParams]:
     out += [MatcherParams(matcher="sad", lr_check=1.0, uniqueness_ratio=10, fill=True, median=5,
                           border="clip"),
             MatcherParams(matcher="ssd", lr_check=1.0),
-            MatcherParams(matcher="ncc", block_size=5, lr_check=1.0, border="clip")]
+            MatcherParams(matcher="ncc", block_size=5, lr_check=1.0, border="clip"),
+            # grey: the census + intensity volume (a window over 1) on a contiguous plane
+            # rather than a view of a colour image
+            sgm.replace(block_size=3, colour=False)]
     return out
 
 
