@@ -19,7 +19,7 @@ $(BIN)/.installed: pyproject.toml
 
 # numba compiles now (2 processes), not in the user's first run
 $(BIN)/.warmed: $(BIN)/.installed
-	$(BIN)/python -m host.stereo.warm
+	$(BIN)/python -m host.warm
 	touch $@
 
 venv: $(BIN)/.warmed

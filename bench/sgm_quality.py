@@ -48,7 +48,7 @@ STEPS = [
 ]
 WITHOUT = [
     ("defaults with census alone (outside cost 11, P1 8 / P2 32)", DEFAULT.replace(**CENSUS_ONLY)),
-    ("defaults with the intensity term on grey (--grey)", DEFAULT.replace(colour=False)),
+    ("defaults with the intensity term on grey (--no-colour)", DEFAULT.replace(colour=False)),
     ("defaults with the census maximum outside", DEFAULT.replace(outside_cost=CENSUS_BITS)),
     ("defaults with LR 1", DEFAULT.replace(lr_check=1.0)),
     ("defaults without uniqueness", DEFAULT.replace(uniqueness_ratio=0.0)),

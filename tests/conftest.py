@@ -9,6 +9,7 @@ import time
 from pathlib import Path
 
 import pytest
+from numba.core import event
 
 
 def _middlebury() -> Path | None:
@@ -149,8 +150,9 @@ def pytest_collection_modifyitems(config, items) -> None:
 # ---- two workers side by side (pytest-xdist; make test runs -n 2 --dist loadfile) ----------
 # Each file runs whole on one worker (its module fixtures, ports and files stay its own). What
 # files share is made safe here: the firmware ELFs are built once before the workers start
-# (every later make finds them up to date), each worker's Ray keeps its session files apart,
-# and numba's cache is read and written under a lock (host.stereo.warm.lock_cache_files).
+# (every later make finds them up to date) and each worker's Ray keeps its session files apart;
+# numba's cache is read and written under a lock wherever host.stereo is imported
+# (host.stereo.numba_cache).
 WORKER = os.environ.get("PYTEST_XDIST_WORKER")
 if WORKER:
     os.environ.setdefault("RAY_TMPDIR", f"/tmp/ray-{WORKER}")  # short: Ray's socket paths
@@ -166,23 +168,23 @@ def pytest_sessionstart(session) -> None:
                 build.firmware_elf(test_hang)
 
 
-class _NumbaCompiles:
+class _NumbaCompiles(event.Listener):
     """Records the numba kernels compiled (not loaded from the cache) during each test: the
-    warm step (python -m host.stereo.warm) should have compiled them, and compiling costs a
+    warm step (python -m host.warm) should have compiled them, and compiling costs a
     test tens of seconds."""
 
     def __init__(self) -> None:
         self.depth, self.t0, self.seconds, self.names = 0, 0.0, 0.0, []
 
-    def on_start(self, event) -> None:
+    def on_start(self, ev) -> None:
         if self.depth == 0:
             self.t0 = time.perf_counter()
         self.depth += 1
-        func = event.data["dispatcher"].py_func
+        func = ev.data["dispatcher"].py_func
         if not func.__module__.startswith("numba"):  # ours, not numba's own overloads
             self.names.append(f"{func.__module__}.{func.__qualname__}")
 
-    def on_end(self, event) -> None:
+    def on_end(self, ev) -> None:
         self.depth -= 1
         if self.depth == 0:
             self.seconds += time.perf_counter() - self.t0
@@ -193,36 +195,16 @@ class _NumbaCompiles:
         return got
 
 
-def _numba_listener() -> _NumbaCompiles | None:
-    try:
-        from numba.core import event
-    except ImportError:
-        return None
-    from host.stereo.warm import lock_cache_files
-    lock_cache_files()
-    log = _NumbaCompiles()
-
-    class Listener(event.Listener):
-        def on_start(self, ev) -> None:
-            log.on_start(ev)
-
-        def on_end(self, ev) -> None:
-            log.on_end(ev)
-
-    event.register("numba:compile", Listener())
-    return log
-
-
-_COMPILES = _numba_listener()
+_COMPILES = _NumbaCompiles()
+event.register("numba:compile", _COMPILES)
 _COMPILED: dict[tuple[str, str], tuple[float, list[str]]] = {}  # (nodeid, phase)
 
 
 @pytest.hookimpl(hookwrapper=True)
 def pytest_runtest_makereport(item, call):
-    if _COMPILES is not None:
-        seconds, names = _COMPILES.take()
-        if names:  # carried to the controller in the report (pytest-xdist)
-            item.user_properties.append(("numba compiled", (call.when, round(seconds, 1), names)))
+    seconds, names = _COMPILES.take()
+    if names:  # carried to the controller in the report (pytest-xdist)
+        item.user_properties.append(("numba compiled", (call.when, round(seconds, 1), names)))
     yield
 
 

@@ -217,7 +217,7 @@ ROWS = [
     (DISP + ["-o", "{tmp}/o.png", "--block-size", "8"], "block size must be odd"),
     (DISP + ["-o", "{tmp}/o.png", "--block-size", "0"], "argument --block-size: must be >= 1"),
     (DISP + ["-o", "{tmp}/o.png", "--num-disparities", "900"], "wider than the image"),
-    (DISP + ["-o", "{tmp}/o.png", "--uniqueness", "101"], "argument --uniqueness"),
+    (DISP + ["-o", "{tmp}/o.png", "--uniqueness-ratio", "101"], "argument --uniqueness-ratio"),
     # ports
     (["servo", "--camera", "replay:{replay}", "--port", "{tmp}/no-such-port"],
      "no-such-port: no such device"),

@@ -32,8 +32,10 @@ def test_the_old_spellings_give_the_same_map_with_one_note_each(
         tmp_path: Path, pair: list[str]) -> None:
     maps = {}
     for how, flags in (("new", ["--block-size", "7", "--num-disparities", "16",
-                                "--min-disparity", "2"]),
-                       ("old", ["--window", "7", "--num-disp", "16", "--min-disp", "2"])):
+                                "--min-disparity", "2", "--uniqueness-ratio", "15",
+                                "--no-colour"]),
+                       ("old", ["--window", "7", "--num-disp", "16", "--min-disp", "2",
+                                "--uniqueness", "15", "--grey"])):
         npy = tmp_path / f"{how}.npy"
         r = host(*pair, "-o", str(tmp_path / f"{how}.png"), "--npy", str(npy), *flags)
         assert r.returncode == 0, r.stderr
@@ -44,15 +46,35 @@ def test_the_old_spellings_give_the_same_map_with_one_note_each(
         else:
             assert notes == ["note: --window is now --block-size (the old spelling will go)",
                              "note: --num-disp is now --num-disparities (the old spelling will go)",
-                             "note: --min-disp is now --min-disparity (the old spelling will go)"]
+                             "note: --min-disp is now --min-disparity (the old spelling will go)",
+                             "note: --uniqueness is now --uniqueness-ratio (the old spelling will "
+                             "go)",
+                             "note: --grey is now --no-colour (the old spelling will go)"]
     np.testing.assert_array_equal(maps["old"], maps["new"])
+
+
+def test_the_old_spellings_give_the_same_parameters(capsys: pytest.CaptureFixture[str]) -> None:
+    from host.commands.options import params_from_args
+
+    def params(*flags: str) -> MatcherParams:
+        args = build_parser("host").parse_args(["disparity", "l.png", "r.png", "-o", "o.png",
+                                                *flags])
+        return params_from_args(args)
+
+    old = params("--grey", "--uniqueness", "15")
+    assert old == params("--no-colour", "--uniqueness-ratio", "15")
+    assert not old.colour and old.uniqueness_ratio == 15
+    assert params("--grey", "--colour").colour  # the later one wins, as with any flag pair
+    capsys.readouterr()
 
 
 def test_the_old_spellings_are_not_in_the_help() -> None:
     for command in ("eval", "disparity", "tune", "servo"):
         text = host(command, "--help").stdout
         assert "--block-size" in text and "--num-disparities" in text
+        assert "--uniqueness-ratio" in text and "--no-colour" in text
         assert "--window " not in text and "--num-disp " not in text and "--windows" not in text
+        assert "--uniqueness " not in text and "--grey" not in text
 
 
 def test_tune_reads_the_old_space_and_range_names(capsys: pytest.CaptureFixture[str]) -> None:
@@ -85,7 +107,8 @@ def test_an_old_params_file_is_read_with_its_space_renamed(
 
 @pytest.mark.parametrize("key, new", [("window", "block_size"), ("num_disp", "num_disparities"),
                                       ("num-disp", "num_disparities"),
-                                      ("min_disp", "min_disparity")])
+                                      ("min_disp", "min_disparity"),
+                                      ("uniqueness", "uniqueness_ratio")])
 def test_a_matcher_key_spelt_the_command_line_way_is_refused_naming_the_key(
         tmp_path: Path, pair: list[str], key: str, new: str) -> None:
     path = tmp_path / "p.toml"

@@ -49,7 +49,7 @@ def run(args: argparse.Namespace) -> int:
     if left.ndim != right.ndim and params.colour:  # colour matching needs two colour views
         kinds = {2: "grey", 3: "colour"}
         raise HostError(f"{args.left} is {kinds[left.ndim]} and {args.right} "
-                        f"{kinds[right.ndim]}: give a pair of one kind, or --grey")
+                        f"{kinds[right.ndim]}: give a pair of one kind, or --no-colour")
     t0 = time.perf_counter()
     disp = compute_disparity(left, right, params)
     ms = (time.perf_counter() - t0) * 1000

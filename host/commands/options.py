@@ -93,13 +93,18 @@ class _OldSpelling(argparse.Action):
                  values: Any, option_string: str | None = None) -> None:
         print(f"note: {option_string} is now {self.new} (the old spelling will go)",
               file=sys.stderr)
-        setattr(namespace, self.dest, values)
+        setattr(namespace, self.dest, self.const if self.nargs == 0 else values)
 
 
 def add_old_spelling(g: argparse._ActionsContainer, old: str, new: argparse.Action) -> None:
-    """old (e.g. --window) read as the option new (--block-size), with a note (_OldSpelling)."""
-    g.add_argument(old, dest=new.dest, type=new.type or str, action=_OldSpelling,
-                   new=new.option_strings[0])
+    """old (e.g. --window, --grey) read as the option new (--block-size, --no-colour: a flag
+    stores what new stores), with a note (_OldSpelling)."""
+    if new.nargs == 0:
+        g.add_argument(old, dest=new.dest, nargs=0, const=new.const, action=_OldSpelling,
+                       new=new.option_strings[0])
+    else:
+        g.add_argument(old, dest=new.dest, type=new.type or str, action=_OldSpelling,
+                       new=new.option_strings[0])
 
 
 def add_matcher_options(p: argparse.ArgumentParser) -> None:
@@ -109,21 +114,18 @@ def add_matcher_options(p: argparse.ArgumentParser) -> None:
                    help="matching cost, or an OpenCV matcher; each starts from its measured "
                         "best settings (sgm: block size 1, clip, LR 0, uniqueness 30, fill, "
                         "4 paths, median 5, whole pixels)")
-    new = {a.dest: a for a in (
-        g.add_argument(option("block_size"), type=int_range(1), metavar="N",
-                       help="side of the matching window, odd (px)"),
-        g.add_argument(option("num_disparities"), type=COUNT, metavar="N",
-                       help="number of disparities (default: from the scene's ground truth, "
-                            "else 64)"),
-        g.add_argument(option("min_disparity"), type=int, metavar="N",
-                       help="smallest disparity (px)"))}
-    for old, field in renamed.PARAMETERS.items():
-        add_old_spelling(g, option(old), new[field])
+    new = [g.add_argument(option("block_size"), type=int_range(1), metavar="N",
+                          help="side of the matching window, odd (px)"),
+           g.add_argument(option("num_disparities"), type=COUNT, metavar="N",
+                          help="number of disparities (default: from the scene's ground truth, "
+                               "else 64)"),
+           g.add_argument(option("min_disparity"), type=int, metavar="N",
+                          help="smallest disparity (px)")]
     g.add_argument("--lr-check", type=_tolerance_or_off, metavar="PX",
                    help="left-right consistency tolerance (px), or off (the matcher's default "
                         "when not given)")
-    g.add_argument("--uniqueness", type=float_range(0, 100), metavar="PCT",
-                   help="uniqueness ratio (%%)")
+    new.append(g.add_argument(option("uniqueness_ratio"), type=float_range(0, 100),
+                              metavar="PCT", help="uniqueness ratio (%%)"))
     g.add_argument("--border", choices=BORDERS, help="window at the image edge: invalid or clip")
     g.add_argument("--fill", action="store_true", default=None,
                    help="fill invalid pixels from the farther neighbour")
@@ -136,15 +138,17 @@ def add_matcher_options(p: argparse.ArgumentParser) -> None:
                    help="sub-pixel disparities (a fit through the costs beside the winner)")
     g.add_argument("--no-subpixel", dest="subpixel", action="store_false", default=None,
                    help="whole-pixel disparities (the own SGM's default)")
-    g.add_argument("--grey", dest="colour", action="store_false", default=None,
-                   help="match on grey even when the images have colour")
+    g.add_argument("--colour", action="store_true", default=None,
+                   help="match on the colour planes when the images have colour")
+    new.append(g.add_argument("--no-colour", dest="colour", action="store_false", default=None,
+                              help="match on grey even when the images have colour"))
+    by_option = {a.option_strings[0]: a for a in new}
+    for old, name in (renamed.PARAMETERS | renamed.FLAGS).items():
+        add_old_spelling(g, option(old), by_option[option(name)])
 
 
-_FIELDS = {"matcher": "matcher", "block_size": "block_size",
-           "num_disparities": "num_disparities", "min_disparity": "min_disparity",
-           "lr_check": "lr_check", "uniqueness": "uniqueness_ratio", "border": "border",
-           "fill": "fill", "median": "median", "subpixel": "subpixel", "colour": "colour",
-           "paths": "paths"}
+_FIELDS = ("matcher", "block_size", "num_disparities", "min_disparity", "lr_check",
+           "uniqueness_ratio", "border", "fill", "median", "subpixel", "colour", "paths")
 
 
 def params_from_args(args: argparse.Namespace) -> MatcherParams:
@@ -154,7 +158,7 @@ def params_from_args(args: argparse.Namespace) -> MatcherParams:
         base = load_params(args.params)[0]
     else:
         base = MatcherParams.for_matcher(args.matcher or MatcherParams.matcher)
-    changes = {f: getattr(args, a) for a, f in _FIELDS.items() if getattr(args, a) is not None}
+    changes = {f: getattr(args, f) for f in _FIELDS if getattr(args, f) is not None}
     if changes.get("lr_check") == -1.0:
         changes["lr_check"] = None
     return base.replace(**changes).validate()

@@ -174,12 +174,18 @@ def test_set_config_limits_are_enforced_on_the_wire(harness, firmware_elf) -> No
 # --- duplicates ---
 
 
-def test_a_command_differing_only_in_its_id_is_applied(harness, firmware_elf) -> None:
-    """duplicate-ignores-id: SET_CONFIG 250 ms / 0 and SET_DRIVE 250 / 0 have the same payload
-    bytes; with the same SEQ the second is still a new command."""
+def _same_payload() -> tuple[gen.SetConfig, gen.SetDrive]:
+    """A SET_CONFIG (250 ms / 0) and a SET_DRIVE (250 / 0) whose payload bytes are the same."""
     config = gen.SetConfig(link_timeout_ms=250, accel_limit=0)
     drive = gen.SetDrive(left=250, right=0)
     assert pack(config)[1] == pack(drive)[1]
+    return config, drive
+
+
+def test_a_command_differing_only_in_its_id_is_applied(harness, firmware_elf) -> None:
+    """duplicate-ignores-id: SET_CONFIG 250 ms / 0 and SET_DRIVE 250 / 0 have the same payload
+    bytes; with the same SEQ the second is still a new command."""
+    config, drive = _same_payload()
     p = Plan().run(2).msg(5, config).run(3).msg(5, drive).run(10)
     r = run(harness, firmware_elf, p.script)
     assert acks(r, 5) == [gen.AckResult.APPLIED, gen.AckResult.APPLIED]
@@ -192,9 +198,7 @@ def test_a_command_differing_only_in_its_id_from_the_drive_in_force_is_applied(
     of the SET_DRIVE in force is a new command (ACK APPLIED), not a resend of the drive. (The
     other order no longer tells: a SET_DRIVE after a SET_CONFIG finds no drive armed, and a
     drive not armed is applied again whatever it matched.)"""
-    config = gen.SetConfig(link_timeout_ms=250, accel_limit=0)
-    drive = gen.SetDrive(left=250, right=0)
-    assert pack(config)[1] == pack(drive)[1]
+    config, drive = _same_payload()
     p = Plan().run(2).msg(5, drive).run(3).msg(5, config).run(10)
     r = run(harness, firmware_elf, p.script)
     assert acks(r, 5) == [gen.AckResult.APPLIED, gen.AckResult.APPLIED]

@@ -1,27 +1,27 @@
 """Compile every numba kernel signature users hit into numba's cache (run at installation).
 
-`python -m host.stereo.warm` (the Makefile's venv step runs it) calls each own matcher on a
-small random pair with every lane width, channel count and option that selects a different
-compiled signature, so the first `host eval` loads machine code instead of compiling it.
-The variants are shared among `--processes` processes (default: one per core, at most 2):
-compiling is single-threaded, and the two 4-path SGM signatures alone take most of the time.
+`python -m host.warm` (the Makefile's venv step runs it) calls each own matcher on a small
+random pair with every lane width, channel count and option that selects a different compiled
+signature, and the self-supervised tuner's census and terms (host tune --objective self), so
+the first `host eval` or `host tune` loads machine code instead of compiling it. The jobs are
+shared among `--processes` processes (default: one per core, at most 2): compiling is
+single-threaded, and the two 4-path SGM signatures alone take most of the time. It sits above
+host.stereo and host.tuning, whose kernels it compiles.
 """
 
 from __future__ import annotations
 
 import argparse
-import fcntl
 import os
 import subprocess
 import sys
 import time
-from collections.abc import Callable
-from typing import Any
 
 import numpy as np
 
 from host.stereo.matcher import compute_disparity
 from host.stereo.params import MatcherParams
+from host.tuning.self_supervised import terms_of_maps
 
 
 def variants() -> list[MatcherParams]:
@@ -41,13 +41,25 @@ def variants() -> list[MatcherParams]:
     out += [MatcherParams(matcher="sad", lr_check=1.0, uniqueness_ratio=10, fill=True, median=5,
                           border="clip"),
             MatcherParams(matcher="ssd", lr_check=1.0),
-            MatcherParams(matcher="ncc", block_size=5, lr_check=1.0, border="clip")]
+            MatcherParams(matcher="ncc", block_size=5, lr_check=1.0, border="clip"),
+            # grey: the census + intensity volume (a window over 1) on a contiguous plane
+            # rather than a view of a colour image
+            sgm.replace(block_size=3, colour=False)]
     return out
 
 
+def _tuner(rng: np.random.Generator) -> None:
+    """The self-supervised objective's kernels (census, terms) on a pair and a map of the
+    dtypes its score passes (uint8 BGR pair, float32 map with NaN where no disparity)."""
+    left = rng.integers(0, 256, (40, 96, 3), dtype=np.uint8)
+    disp = np.full(left.shape[:2], 3.0, np.float32)
+    disp[:, :8] = np.nan
+    terms_of_maps(left, np.roll(left, -3, axis=1), disp)
+
+
 def warm(part: int = 0, parts: int = 1) -> int:
-    """Run every parts-th variant from part on once on a small random colour pair; returns how
-    many ran."""
+    """Run every parts-th matcher variant from part on once on a small random colour pair, and
+    in the last part the tuner's kernels; returns how many jobs ran."""
     rng = np.random.default_rng(0)
     ps = variants()[part::parts]
     for p in ps:
@@ -55,36 +67,13 @@ def warm(part: int = 0, parts: int = 1) -> int:
         left = rng.integers(0, 256, size, dtype=np.uint8)
         right = np.roll(left, -3, axis=1)
         compute_disparity(left, right, p.replace(num_disparities=16))
-    return len(ps)
-
-
-def lock_cache_files() -> None:
-    """Make numba's cache updates safe between processes compiling at once (the warm step's
-    parts, pytest's workers). numba's IndexDataCacheFile.save reads a function's index, adds
-    its new signature with the first free data file number and writes both back; two processes
-    adding different signatures of one function at once can both take number 1, and the index
-    then names the other signature's machine code. Each save and load here holds an exclusive
-    lock on a file beside the function's index for its read-modify-write."""
-    from numba.core import caching
-
-    cls: Any = caching.IndexDataCacheFile
-    if getattr(cls, "locked_by_stereo_servo", False):
-        return
-
-    def locked(fn: Callable[..., Any]) -> Callable[..., Any]:
-        def run(self: Any, *args: Any) -> Any:
-            os.makedirs(self._cache_path, exist_ok=True)
-            with open(self._index_path + ".lock", "a") as f:
-                fcntl.flock(f, fcntl.LOCK_EX)
-                return fn(self, *args)
-        return run
-
-    cls.save, cls.load = locked(cls.save), locked(cls.load)
-    cls.locked_by_stereo_servo = True
+    if part == parts - 1:
+        _tuner(rng)
+    return len(ps) + (part == parts - 1)
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m host.stereo.warm", description=__doc__)
+    ap = argparse.ArgumentParser(prog="python -m host.warm", description=__doc__)
     ap.add_argument("--processes", type=int, default=min(2, os.cpu_count() or 1),
                     help="processes compiling at once (default: cores, at most 2)")
     ap.add_argument("--part", type=int, default=None, help=argparse.SUPPRESS)
@@ -92,7 +81,6 @@ def main(argv: list[str] | None = None) -> int:
     if args.processes < 1:
         print(f"--processes must be at least 1, got {args.processes}", file=sys.stderr)
         return 2
-    lock_cache_files()
     t0 = time.perf_counter()
     if args.part is not None:  # one of the processes below
         warm(args.part, args.processes)
@@ -100,14 +88,15 @@ def main(argv: list[str] | None = None) -> int:
     if args.processes == 1:
         n = warm()
     else:
-        parts = [subprocess.Popen([sys.executable, "-m", "host.stereo.warm", "--processes",
+        parts = [subprocess.Popen([sys.executable, "-m", "host.warm", "--processes",
                                    str(args.processes), "--part", str(k)])
                  for k in range(args.processes)]
         if any(p.wait() for p in parts):
             print("a warm-up process failed (above)", file=sys.stderr)
             return 1
-        n = len(variants())
-    print(f"numba kernels compiled or loaded from cache: {n} matcher variants in "
+        n = len(variants()) + 1
+    print(f"numba kernels compiled or loaded from cache: {n} jobs (matcher variants, the "
+          f"self-supervised tuner) in "
           f"{args.processes} processes, {time.perf_counter() - t0:.1f} s", file=sys.stderr)
     return 0
 
