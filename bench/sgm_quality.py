@@ -44,10 +44,14 @@ STEPS = [
     ("+ intensity term on grey (weight 1, cap 20), outside 23", _MIXED.replace(colour=False)),
     ("+ the intensity term on colour", _MIXED),
     ("+ LR 0, uniqueness 30", _MIXED.replace(lr_check=0.0, uniqueness_ratio=30)),
-    ("+ P1 18 / P2 72, 4 paths = the defaults", DEFAULT),
+    ("+ P1 18 / P2 72, 4 paths (the defaults before)", DEFAULT.replace(p2_adapt=0.0)),
+    ("+ adaptive P2, 128 / (1 + grey step / 16) = the defaults", DEFAULT),
 ]
 WITHOUT = [
-    ("defaults with census alone (outside cost 11, P1 8 / P2 32)", DEFAULT.replace(**CENSUS_ONLY)),
+    ("defaults with census alone (outside cost 11, P1 8, P2 56 adaptive)",
+     DEFAULT.replace(**CENSUS_ONLY)),
+    ("the same with a fixed P2 (32)", DEFAULT.replace(p2_adapt=0.0, **CENSUS_ONLY)),
+    ("defaults with a fixed P2 (72)", DEFAULT.replace(p2_adapt=0.0)),
     ("defaults with the intensity term on grey (--no-colour)", DEFAULT.replace(colour=False)),
     ("defaults with the census maximum outside", DEFAULT.replace(outside_cost=CENSUS_BITS)),
     ("defaults with LR 1", DEFAULT.replace(lr_check=1.0)),

@@ -26,6 +26,10 @@ SGM_P1 = 8  # default SGM penalties per pixel of the cost box (census bits)
 SGM_P2 = 32
 SGM_MIXED_P1 = 18  # the same with the intensity term (MatcherParams.intensity_weight > 0)
 SGM_MIXED_P2 = 72
+# the base P2 (at no grey step) of an adaptive P2 (MatcherParams.p2_adapt > 0): 16/9 of the
+# fixed one, so a step of p2_adapt grey levels gets about the fixed P2's half (docs/stereo.md)
+SGM_ADAPTIVE_P2 = 56
+SGM_MIXED_ADAPTIVE_P2 = 128
 # pixel-disparities (about 1.5 ms of SAD on one core) below which a match runs on the calling
 # thread alone: waking numba's thread pool costs more than it saves there, and on a loaded
 # machine a sleeping worker took 7-40 ms to join a 0.2 ms match of the servo's marker window
@@ -120,9 +124,15 @@ def sad_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
 def sgm_penalties(p: MatcherParams) -> tuple[int, int]:
     """(P1, P2) for the own SGM: p.p1 / p.p2 when set, else the defaults per pixel of the cost
     box: SGM_P1 / SGM_P2 for census alone, SGM_MIXED_P1 / SGM_MIXED_P2 with the intensity term
-    (its costs span more; measured on the ten shared scenes, docs/stereo.md)."""
+    (its costs span more; measured on the ten shared scenes, docs/stereo.md); with an
+    adaptive P2 (p.p2_adapt) the base P2 is SGM_ADAPTIVE_P2 / SGM_MIXED_ADAPTIVE_P2."""
     area = p.block_size ** 2
-    base1, base2 = (SGM_MIXED_P1, SGM_MIXED_P2) if p.intensity_weight > 0 else (SGM_P1, SGM_P2)
+    mixed = p.intensity_weight > 0
+    base1 = SGM_MIXED_P1 if mixed else SGM_P1
+    if p.p2_adapt > 0:
+        base2 = SGM_MIXED_ADAPTIVE_P2 if mixed else SGM_ADAPTIVE_P2
+    else:
+        base2 = SGM_MIXED_P2 if mixed else SGM_P2
     p1 = p.p1 or base1 * area
     return p1, max(p.p2 or base2 * area, p1)
 
@@ -185,6 +195,7 @@ def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
     map kept)."""
     gl, gr = [cv2.copyMakeBorder(to_grey(v), sgm.CENSUS_H, sgm.CENSUS_H, sgm.CENSUS_W,
                                  sgm.CENSUS_W, cv2.BORDER_REPLICATE) for v in (left, right)]
+    grey = gl  # the image steps of an adaptive P2 (kept when the cost is in a volume)
     shape = left.shape[:2]
     cl, cr = sgm.NO_CENSUS, sgm.NO_CENSUS
     vol, planes, rplanes, term = NO_VOLUME, sgm.NO_PLANES, sgm.NO_PLANES, sgm.census_term()
@@ -239,7 +250,8 @@ def sgm_disparity(left: np.ndarray, right: np.ndarray, p: MatcherParams) -> np.n
     lr = max(tol, 0.5) if subpixel_fit(p) and tol >= 0 else tol
     disp_l, _ = sgm.match(cl, crrev, vol, sums, p.min_disparity, np.uint16(p1), np.uint16(p2),
                           p.paths, float(p.uniqueness_ratio), subpixel_fit(p), want_right,
-                          False, planes, rplanes, term, costs, four, gl, gr, lr)
+                          False, planes, rplanes, term, costs, four, gl, gr, lr,
+                          float(p.p2_adapt), grey)
     if p.border == "invalid":
         # the census (and box) window of these pixels leaves the image
         ry, rx = sgm.CENSUS_H + p.block_size // 2, sgm.CENSUS_W + p.block_size // 2

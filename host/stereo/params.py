@@ -18,7 +18,8 @@ CENSUS_BITS = 62  # bits of the own SGM's 9x7 census (host.stereo.sgm.CENSUS_BIT
 MATCHER_DEFAULTS: dict[str, dict[str, Any]] = {
     "sgm": {"block_size": 1, "border": "clip", "lr_check": 0.0, "uniqueness_ratio": 30.0,
             "fill": True, "median": 5, "paths": 4, "subpixel": False,
-            "intensity_weight": 1.0, "intensity_cap": 20, "outside_cost": 23},
+            "intensity_weight": 1.0, "intensity_cap": 20, "outside_cost": 23,
+            "p2_adapt": 16.0},
 }
 
 
@@ -37,7 +38,9 @@ class MatcherParams:
     pass), 8 or 4 (left, right, up, down); intensity_weight, intensity_cap = the own SGM's
     intensity term added to census (weight per grey level of |difference|, capped at cap grey
     levels; 0 = census alone); outside_cost = the own SGM's cost of a candidate whose right
-    pixel lies outside the image (CENSUS_BITS, the census maximum, when not lowered).
+    pixel lies outside the image (CENSUS_BITS, the census maximum, when not lowered);
+    p2_adapt = the own SGM's P2 per path step, P2 / (1 + grey step / p2_adapt) (grey levels of
+    the left image between the step's two pixels; at least P1 + 1; 0 = P2 everywhere).
 
     The dataclass defaults are the plain matcher; for_matcher gives each matcher's measured
     best, which is what the commands start from (docs/stereo.md).
@@ -66,6 +69,7 @@ class MatcherParams:
     intensity_weight: float = 0.0
     intensity_cap: int = 20
     outside_cost: int = CENSUS_BITS
+    p2_adapt: float = 0.0
 
     @classmethod
     def for_matcher(cls, matcher: str = "sad") -> MatcherParams:
@@ -133,6 +137,8 @@ class MatcherParams:
                             f"got {self.intensity_cap}")
         if not 0 <= self.outside_cost <= 1024:
             raise HostError(f"outside cost must be in 0..1024, got {self.outside_cost}")
+        if not 0.0 <= self.p2_adapt <= 255.0:
+            raise HostError(f"p2_adapt must be in 0..255 grey levels, got {self.p2_adapt}")
         if self.paths not in SGM_PATHS:
             raise HostError(f"paths must be 4, 5 or 8 (own SGM), got {self.paths}")
         if width is not None:

@@ -8,7 +8,8 @@ Aggregation (Hirschmueller's recurrence): 5 paths in one pass from the top (_dow
 directions that each store their sums for half the image (_sweep); 4 paths, the defaults, in
 blocks of K rows from a stored row of the path from the bottom every K rows, with no volume
 (_vertical, _four). Path costs, sums and penalties are uint16 with the disparity axis
-innermost, so every per-disparity loop runs in 16-bit lanes.
+innermost, so every per-disparity loop runs in 16-bit lanes. P2 is taken per path step from a
+table indexed by the left image's grey step along it (penalty_table: adaptive, or one value).
 
 Candidate j is disparity dmin + j; the left pixel x matches right pixel x - d. A candidate
 whose right pixel falls outside the image costs the most a census can differ (CENSUS_BITS).
@@ -267,6 +268,15 @@ def _step_plain(src, m, dst, c, p1, p2, nd):
     return lo
 
 
+@njit(cache=True, inline="always")
+def _pen(T, G, y, x, yy, xx):
+    """P2 of the path step from pixel (yy, xx) to (y, x): T indexed by the left image's grey
+    step between them (penalty_table; the same P2 everywhere when not adaptive). G is the grey
+    image padded as census takes it (CENSUS_H rows, CENSUS_W columns: the layout of gl)."""
+    a = np.int32(G[y + CENSUS_H, x + CENSUS_W])
+    return T[abs(a - np.int32(G[yy + CENSUS_H, xx + CENSUS_W]))]
+
+
 @njit(cache=True, fastmath=True, inline="always")
 def _start(dst, c, nd):
     """A path's first pixel: L = C; returns min L."""
@@ -407,9 +417,9 @@ def _fit_row(fb, out, dmin, fit, n):
 
 
 @njit(cache=True, fastmath=True)
-def _sweep(cl, crrev, gl, gr, vol, pl, prrev, term, S, C, P, M, crow, tot, forward, i0, i1, p1, p2,
-           diagonals, finish, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc, acc16, sh,
-           keep, lr):
+def _sweep(cl, crrev, gl, gr, vol, pl, prrev, term, S, C, P, M, crow, tot, forward, i0, i1, p1,
+           T, G, diagonals, finish, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc, acc16,
+           sh, keep, lr):
     """Rows i0 .. i1 - 1 (counted from the top when forward, else from the bottom) of one
     direction's paths: path 0 from behind in the row, 2 from the row before at the same x,
     and (diagonals) 1 and 3 from the row before at x - step and x + step.
@@ -453,22 +463,26 @@ def _sweep(cl, crrev, gl, gr, vol, pl, prrev, term, S, C, P, M, crow, tot, forwa
             if t == 0:
                 M[b, 0, x] = _start(h0, c, nd)
             else:
-                M[b, 0, x] = _step(P[b, 0, x - step], M[b, 0, x - step], h0, c, p1, p2, nd)
+                M[b, 0, x] = _step(P[b, 0, x - step], M[b, 0, x - step], h0, c, p1,
+                                   _pen(T, G, y, x, y, x - step), nd)
             if i == 0:
                 M[b, 2, x] = _start(v2, c, nd)
             else:
-                M[b, 2, x] = _step(P[a, 2, x], M[a, 2, x], v2, c, p1, p2, nd)
+                M[b, 2, x] = _step(P[a, 2, x], M[a, 2, x], v2, c, p1, _pen(T, G, y, x, y - step, x),
+                                   nd)
             if diagonals:
                 d1 = P[b, 1, x]
                 d3 = P[b, 3, x]
                 if i == 0 or t == 0:
                     M[b, 1, x] = _start(d1, c, nd)
                 else:
-                    M[b, 1, x] = _step(P[a, 1, x - step], M[a, 1, x - step], d1, c, p1, p2, nd)
+                    M[b, 1, x] = _step(P[a, 1, x - step], M[a, 1, x - step], d1, c, p1,
+                                       _pen(T, G, y, x, y - step, x - step), nd)
                 if i == 0 or t == w - 1:
                     M[b, 3, x] = _start(d3, c, nd)
                 else:
-                    M[b, 3, x] = _step(P[a, 3, x + step], M[a, 3, x + step], d3, c, p1, p2, nd)
+                    M[b, 3, x] = _step(P[a, 3, x + step], M[a, 3, x + step], d3, c, p1,
+                                       _pen(T, G, y, x, y - step, x + step), nd)
                 if finish:
                     mins[x] = _sum_into(tot[x], S[y, x], h0, d1, v2, d3, nd, True)
                 else:
@@ -503,7 +517,7 @@ def _row_scratch(w, nd):
 
 
 @njit(cache=True, fastmath=True, inline="always")
-def _from_the_right(crow, H, tot, mins, Z, p1, p2, nd):
+def _from_the_right(crow, H, tot, mins, Z, p1, T, G, y, nd):
     """The path from the right, swept back along the row (its previous pixel in H): added to
     the row's totals, each pixel's minimum total into mins."""
     w = crow.shape[0]
@@ -512,7 +526,8 @@ def _from_the_right(crow, H, tot, mins, Z, p1, p2, nd):
         x = w - 1 - t
         c = crow[x]
         h4 = H[t % 2]
-        m4 = _start(h4, c, nd) if t == 0 else _step(H[1 - t % 2], m4, h4, c, p1, p2, nd)
+        m4 = _start(h4, c, nd) if t == 0 else _step(H[1 - t % 2], m4, h4, c, p1,
+                                                     _pen(T, G, y, x, y, x + 1), nd)
         mins[x] = _sum_into(tot[x], tot[x], h4, Z, Z, Z, nd, True)
 
 
@@ -520,7 +535,7 @@ OVERLAP = 24  # rows the lower stripe of the 5-path pass starts above its first 
 
 
 @njit(cache=True, fastmath=True)
-def _down(cl, crrev, gl, gr, vol, pl, prrev, term, S, P, M, crow, tot, y0, y1, warm, p1, p2, dmin,
+def _down(cl, crrev, gl, gr, vol, pl, prrev, term, S, P, M, crow, tot, y0, y1, warm, p1, T, G, dmin,
           uniqueness, fit, want_right, disp_l, disp_r, acc, acc16, sh, keep, lr):
     """The 5-path pass over rows y0 .. y1 - 1, top to bottom: paths 1-3 from the top-left,
     top and top-right and 0 from the left in one sweep along the row (x rising), which leaves
@@ -552,23 +567,27 @@ def _down(cl, crrev, gl, gr, vol, pl, prrev, term, S, P, M, crow, tot, y0, y1, w
             if i == 0 or x == 0:
                 M[b, 1, x] = _start(d1, c, nd)
             else:
-                M[b, 1, x] = _step(P[a, 1, x - 1], M[a, 1, x - 1], d1, c, p1, p2, nd)
+                M[b, 1, x] = _step(P[a, 1, x - 1], M[a, 1, x - 1], d1, c, p1,
+                                   _pen(T, G, y, x, y - 1, x - 1), nd)
             if i == 0:
                 M[b, 2, x] = _start(v2, c, nd)
             else:
-                M[b, 2, x] = _step(P[a, 2, x], M[a, 2, x], v2, c, p1, p2, nd)
+                M[b, 2, x] = _step(P[a, 2, x], M[a, 2, x], v2, c, p1, _pen(T, G, y, x, y - 1, x),
+                                   nd)
             if i == 0 or x == w - 1:
                 M[b, 3, x] = _start(d3, c, nd)
             else:
-                M[b, 3, x] = _step(P[a, 3, x + 1], M[a, 3, x + 1], d3, c, p1, p2, nd)
+                M[b, 3, x] = _step(P[a, 3, x + 1], M[a, 3, x + 1], d3, c, p1,
+                                   _pen(T, G, y, x, y - 1, x + 1), nd)
             if not decided:
                 continue
             h0 = H[x % 2]
-            m0 = _start(h0, c, nd) if x == 0 else _step(H[1 - x % 2], m0, h0, c, p1, p2, nd)
+            m0 = _start(h0, c, nd) if x == 0 else _step(H[1 - x % 2], m0, h0, c, p1,
+                                                         _pen(T, G, y, x, y, x - 1), nd)
             _sum_into(tot[x], Z, h0, d1, v2, d3, nd, False)
         if not decided:
             continue
-        _from_the_right(crow, H, tot, mins, Z, p1, p2, nd)
+        _from_the_right(crow, H, tot, mins, Z, p1, T, G, y, nd)
         _decide_row(tot, mins, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc,
                     acc16, sh, idx, jj, fb, rr, lr)
         if keep:
@@ -576,7 +595,7 @@ def _down(cl, crrev, gl, gr, vol, pl, prrev, term, S, P, M, crow, tot, y0, y1, w
 
 
 @njit(cache=True, fastmath=True)
-def _vertical(cl, crrev, gl, gr, vol, pl, prrev, term, forward, rows, K, ck, ckm, p1, p2, dmin):
+def _vertical(cl, crrev, gl, gr, vol, pl, prrev, term, forward, rows, K, ck, ckm, p1, T, G, dmin):
     """The path from the bottom (not forward: rows h - 1 up to h - rows) or from the top
     (forward: rows 0 .. rows - 1) alone, keeping two rows of it. Going up, the path's row y is
     stored in ck[y // K - 1] (ckm: its minima) at every y that is a multiple of K above 0
@@ -598,7 +617,8 @@ def _vertical(cl, crrev, gl, gr, vol, pl, prrev, term, forward, rows, K, ck, ckm
             if i == 0:
                 M[b, x] = _start(P[b, x], crow[x], nd)
             else:
-                M[b, x] = _step(P[1 - b, x], M[1 - b, x], P[b, x], crow[x], p1, p2, nd)
+                M[b, x] = _step(P[1 - b, x], M[1 - b, x], P[b, x], crow[x], p1,
+                                 _pen(T, G, y, x, y - 1 if forward else y + 1, x), nd)
         if forward:
             store = i == rows - 1
             k = 0
@@ -615,8 +635,8 @@ def _vertical(cl, crrev, gl, gr, vol, pl, prrev, term, forward, rows, K, ck, ckm
 
 
 @njit(cache=True, fastmath=True)
-def _four(cl, crrev, gl, gr, vol, pl, prrev, term, S, y0, y1, K, ck, ckm, top, topm, BB, CB, p1, p2,
-          dmin, uniqueness, fit, want_right, disp_l, disp_r, sh, keep, lr):
+def _four(cl, crrev, gl, gr, vol, pl, prrev, term, S, y0, y1, K, ck, ckm, top, topm, BB, CB, p1,
+          T, G, dmin, uniqueness, fit, want_right, disp_l, disp_r, sh, keep, lr):
     """The 4-path pass (left, right, top, bottom) over rows y0 .. y1 - 1 in blocks of K rows,
     without a volume: for each block, the path from the bottom is taken up through it again
     from the stored row below it (ck, ckm: _vertical; at the image's last row it starts),
@@ -674,9 +694,11 @@ def _four(cl, crrev, gl, gr, vol, pl, prrev, term, S, y0, y1, K, ck, ckm, top, t
                     src = ck[b1 // K - 1, x]
                     for j in range(nd):
                         below[j + 1] = src[j]
-                    MB[b, x] = _step(below, ckm[b1 // K - 1, x], dst, c, p1, p2, nd)
+                    MB[b, x] = _step(below, ckm[b1 // K - 1, x], dst, c, p1,
+                                      _pen(T, G, y, x, y + 1, x), nd)
                 else:
-                    MB[b, x] = _step(BB[r + 1, x], MB[1 - b, x], dst, c, p1, p2, nd)
+                    MB[b, x] = _step(BB[r + 1, x], MB[1 - b, x], dst, c, p1,
+                                      _pen(T, G, y, x, y + 1, x), nd)
         for y in range(b0, b1):
             r = y - b0
             if kept:
@@ -696,12 +718,12 @@ def _four(cl, crrev, gl, gr, vol, pl, prrev, term, S, y0, y1, K, ck, ckm, top, t
                 if y == 0:
                     M[b, x] = _start(v, c, nd)
                 else:
-                    M[b, x] = _step(P[a, x], M[a, x], v, c, p1, p2, nd)
+                    M[b, x] = _step(P[a, x], M[a, x], v, c, p1, _pen(T, G, y, x, y - 1, x), nd)
                 h0 = H[x % 2]
-                m0 = _start(h0, c, nd) if x == 0 else _step(H[1 - x % 2], m0, h0, c, p1, p2,
-                                                            nd)
+                m0 = _start(h0, c, nd) if x == 0 else _step(H[1 - x % 2], m0, h0, c, p1,
+                                                            _pen(T, G, y, x, y, x - 1), nd)
                 _sum_into(tot[x], Z, h0, v, BB[r, x], Z, nd, False)
-            _from_the_right(crow, H, tot, mins, Z, p1, p2, nd)
+            _from_the_right(crow, H, tot, mins, Z, p1, T, G, y, nd)
             _decide_row(tot, mins, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc,
                         acc16, sh, idx, jj, fb, rr, lr)
             if keep:
@@ -725,7 +747,7 @@ def _buffers(n, w, nd):
 
 
 @njit(cache=True, parallel=True)
-def _match(cl, crrev, gl, gr, vol, pl, prrev, term, S, C, dmin, p1, p2, paths, uniqueness, fit,
+def _match(cl, crrev, gl, gr, vol, pl, prrev, term, S, C, dmin, p1, T, G, paths, uniqueness, fit,
            want_right, keep, K, ck, ckm, top, topm, BB, CB, lr):
     """Semi-global matching of census images cl and crrev, or (gl has rows) of the census
     rows made from the padded grey images gl, gr where a pass needs them (see _cost_row):
@@ -746,6 +768,8 @@ def _match(cl, crrev, gl, gr, vol, pl, prrev, term, S, C, dmin, p1, p2, paths, u
     per thread), and the lower stripe's paths from above start OVERLAP rows above it, the same
     whatever the thread count, so results do not depend on it.
     keep: leave the total path costs in S (rows, cols, nd; for tests).
+    T, G: P2 of each path step, T[|G[p] - G[p - r]|] (penalty_table; G the left image's grey
+    levels padded as gl is, see _pen); every kernel below takes them in place of one P2.
     """
     h, w = _size(cl, gl)
     nd = S.shape[2]
@@ -755,7 +779,7 @@ def _match(cl, crrev, gl, gr, vol, pl, prrev, term, S, C, dmin, p1, p2, paths, u
     while (1 << bits) < nd:
         bits += 1
     cmax = int(term[5]) if vol.shape[0] == 0 else int(vol.max())
-    sh = bits if bits > 0 and (paths * (cmax + int(p2)) + 1) << bits <= 0xFFFF else 0
+    sh = bits if bits > 0 and (paths * (cmax + int(T.max())) + 1) << bits <= 0xFFFF else 0
     disp_l = np.full((h, w), np.nan, dtype=np.float32)
     disp_r = np.full((h if lr < 0.0 else 0, w), np.nan, dtype=np.float32)
     upper = (h + 1) // 2
@@ -766,7 +790,7 @@ def _match(cl, crrev, gl, gr, vol, pl, prrev, term, S, C, dmin, p1, p2, paths, u
             P, M, crow, tot, acc, acc16 = _buffers(1, w, nd)
             y0, y1 = (0, upper) if k == 0 else (upper, h)
             _down(cl, crrev, gl, gr, vol, pl, prrev, term, S, P[0], M[0], crow[0], tot[0], y0, y1,
-                  0 if k == 0 else min(OVERLAP, upper), p1, p2, dmin, uniqueness, fit,
+                  0 if k == 0 else min(OVERLAP, upper), p1, T, G, dmin, uniqueness, fit,
                   want_right, disp_l, disp_r, acc[0], acc16[0], sh, keep, lr)
         return disp_l, disp_r
     if paths == 4:
@@ -779,15 +803,15 @@ def _match(cl, crrev, gl, gr, vol, pl, prrev, term, S, C, dmin, p1, p2, paths, u
         for k in prange(2):
             if k == 0:
                 _vertical(cl, crrev, gl, gr, vol, pl, prrev, term, False, max(h - K, 0), K, ck, ckm,
-                          p1, p2, dmin)
+                          p1, T, G, dmin)
             elif stripes == 2:
-                _vertical(cl, crrev, gl, gr, vol, pl, prrev, term, True, mid, K, top, topm, p1, p2,
-                          dmin)
+                _vertical(cl, crrev, gl, gr, vol, pl, prrev, term, True, mid, K, top, topm, p1,
+                          T, G, dmin)
         for k in prange(2):
             if k < stripes:
                 y0, y1 = (0, mid) if k == 0 else (mid, h)
                 _four(cl, crrev, gl, gr, vol, pl, prrev, term, S, y0, y1, K, ck, ckm, top[0],
-                      topm[0], BB[k], CB[k], p1, p2, dmin, uniqueness, fit, want_right, disp_l,
+                      topm[0], BB[k], CB[k], p1, T, G, dmin, uniqueness, fit, want_right, disp_l,
                       disp_r, sh, keep, lr)
         return disp_l, disp_r
     P, M, crow, tot, acc, acc16 = _buffers(2, w, nd)  # the directions go on from row to row
@@ -800,7 +824,7 @@ def _match(cl, crrev, gl, gr, vol, pl, prrev, term, S, C, dmin, p1, p2, paths, u
             else:
                 i0, i1 = upper if forward else h - upper, h
             _sweep(cl, crrev, gl, gr, vol, pl, prrev, term, S, C, P[k], M[k], crow[k], tot[k],
-                   forward, i0, i1, p1, p2, diagonals, phase == 1, dmin, uniqueness, fit,
+                   forward, i0, i1, p1, T, G, diagonals, phase == 1, dmin, uniqueness, fit,
                    want_right, disp_l, disp_r, acc[k], acc16[k], sh, keep, lr)
     return disp_l, disp_r
 
@@ -822,8 +846,8 @@ def match(cl: np.ndarray, crrev: np.ndarray, vol: np.ndarray, S: np.ndarray, dmi
           want_right: bool, keep: bool, pl: np.ndarray = NO_PLANES,
           prrev: np.ndarray = NO_PLANES, term: np.ndarray | None = None,
           costs: np.ndarray = NO_COSTS, four: FourPath | None = None,
-          gl: np.ndarray = NO_GREY, gr: np.ndarray = NO_GREY, lr: float = -1.0
-          ) -> tuple[np.ndarray, np.ndarray]:
+          gl: np.ndarray = NO_GREY, gr: np.ndarray = NO_GREY, lr: float = -1.0,
+          p2_adapt: float = 0.0, grey: np.ndarray = NO_GREY) -> tuple[np.ndarray, np.ndarray]:
     """_match with the cost from vol, or (vol empty) from the census rows plus, where pl has
     channels, the intensity term of the planes pl and prrev (cost.reversed_planes) as
     term says (cost.integer_term; default: census alone, CENSUS_BITS outside the image).
@@ -834,19 +858,39 @@ def match(cl: np.ndarray, crrev: np.ndarray, vol: np.ndarray, S: np.ndarray, dmi
     gl, gr: the grey images padded as census takes them, the census rows then made where they
     are used (cl, crrev: NO_CENSUS); lr: the LR check's tolerance, done row by row (no right
     map is kept: the second map returned has no rows), or negative: no check, the right map
-    returned."""
+    returned. p2_adapt > 0: each path step's P2 falls with the left image's grey step along it
+    (penalty_table; grey: the left image's grey levels padded as gl, which is taken when grey
+    is not given), else P2 is p2."""
     term = census_term() if term is None else term
     h, w = (gl.shape[0] - 2 * CENSUS_H, gl.shape[1] - 2 * CENSUS_W) if gl.shape[0] else cl.shape
     nd = S.shape[2]
+    T = penalty_table(int(p1), int(p2), p2_adapt)
+    G = grey if grey.shape[0] else gl
+    if not G.shape[0]:  # T is one value then: any grey levels do
+        G = np.zeros((h + 2 * CENSUS_H, w + 2 * CENSUS_W), dtype=np.uint8)
+    if G.shape != (h + 2 * CENSUS_H, w + 2 * CENSUS_W):
+        raise ValueError(f"grey is {G.shape}, the images {(h, w)} padded by the census")
     if four is None:
         four = FourPath.make(h, w, nd, largest_cost(vol, term), int(p2), vol.shape[0] == 0,
                              1 if paths == 4 else 0)
     disp_l: np.ndarray
     disp_r: np.ndarray
-    disp_l, disp_r = _match(cl, crrev, gl, gr, vol, pl, prrev, term, S, costs, dmin, p1, p2, paths,
-                            uniqueness, fit, want_right, keep, four.K, four.ck, four.ckm,
+    disp_l, disp_r = _match(cl, crrev, gl, gr, vol, pl, prrev, term, S, costs, dmin, p1, T, G,
+                            paths, uniqueness, fit, want_right, keep, four.K, four.ck, four.ckm,
                             four.top, four.topm, four.BB, four.CB, float(lr))
     return disp_l, disp_r
+
+
+def penalty_table(p1: int, p2: int, adapt: float) -> np.ndarray:
+    """P2 of a path step by the left image's grey step k = 0 .. 255 along it (uint16): p2
+    everywhere when adapt <= 0, else p2 / (1 + k / adapt) rounded, at least P1 + 1 (at most
+    p2): a smaller jump penalty where the image has an edge, where depth edges lie, and a
+    larger one on flat surfaces (Hirschmueller 2008 takes P2 / |step|)."""
+    k = np.arange(256, dtype=np.float64)
+    if adapt <= 0:
+        return np.full(256, p2, dtype=np.uint16)
+    t = np.floor(p2 / (1.0 + k / adapt) + 0.5)
+    return np.clip(t, min(p1 + 1, p2), p2).astype(np.uint16)
 
 
 def largest_cost(vol: np.ndarray, term: np.ndarray) -> int:

@@ -49,8 +49,10 @@ FOUR = [(0, 1), (1, 0), (0, -1), (-1, 0)]
 FIVE = [(0, 1), (0, -1), (1, 1), (1, 0), (1, -1)]
 
 
-def _naive_paths(cost: np.ndarray, p1: int, p2: int, dirs: list[tuple[int, int]]) -> np.ndarray:
-    # Hirschmueller's recurrence along the given (dy, dx) directions, written out plainly
+def _naive_paths(cost: np.ndarray, p1: int, p2: int, dirs: list[tuple[int, int]],
+                 grey: np.ndarray | None = None, adapt: float = 0.0) -> np.ndarray:
+    # Hirschmueller's recurrence along the given (dy, dx) directions, written out plainly;
+    # with grey, P2 of each step is p2 / (1 + |grey step| / adapt), rounded, in P1 + 1 .. p2
     h, w, nd = cost.shape
     c = cost.astype(np.int64)
     total = np.zeros_like(c)
@@ -66,8 +68,12 @@ def _naive_paths(cost: np.ndarray, p1: int, p2: int, dirs: list[tuple[int, int]]
                     continue
                 prev = lr[py, px]
                 m = prev.min()
+                step_p2 = p2
+                if grey is not None:
+                    k = abs(int(grey[y, x]) - int(grey[py, px]))
+                    step_p2 = min(max(int(np.floor(p2 / (1 + k / adapt) + 0.5)), p1 + 1), p2)
                 for d in range(nd):
-                    best = min(prev[d], m + p2)
+                    best = min(prev[d], m + step_p2)
                     if d > 0:
                         best = min(best, prev[d - 1] + p1)
                     if d < nd - 1:
@@ -97,6 +103,40 @@ def test_path_aggregation_equals_the_plain_recurrence(paths, dirs, shape) -> Non
     cost = rng.integers(0, 63, shape).astype(np.uint16)
     _, _, total = _match(cost, 7, 30, paths)
     np.testing.assert_array_equal(total, _naive_paths(cost, 7, 30, dirs))
+
+
+@pytest.mark.parametrize(("paths", "dirs"), [(8, EIGHT), (5, FIVE), (4, FOUR)])
+@pytest.mark.parametrize("shape", [(6, 7, 5), (9, 5, 8), (5, 6, 17), (7, 11, 40)])
+@pytest.mark.parametrize("stripes", [1, 2])
+def test_adaptive_p2_totals_equal_the_plain_recurrence_with_each_steps_p2(paths, dirs, shape,
+                                                                        stripes) -> None:
+    # each path step's P2 from the grey step between its two pixels (p2_adapt): every
+    # direction must look up the pixel it comes from, in both stripes of the 4-path pass
+    rng = np.random.default_rng(shape[2])
+    h, w, nd = shape
+    cost = rng.integers(0, 63, shape).astype(np.uint16)
+    grey = rng.integers(0, 256, (h, w)).astype(np.uint8)
+    grey[:, w // 2:] = grey[:, w // 2:] // 16 + 100  # some small steps, some large
+    none = np.zeros((h, w), np.uint64)
+    total = np.empty_like(cost)
+    four = sgm.FourPath.make(h, w, nd, int(cost.max()), 90, False, stripes if paths == 4 else 0,
+                             2 if paths == 4 else None)
+    with numba_threads(stripes):
+        sgm.match(none, sgm.reversed_right(none, 0, nd), cost, total, 0, np.uint16(7),
+                  np.uint16(90), paths, 0.0, 0, True, True, four=four, p2_adapt=8.0,
+                  grey=cv2.copyMakeBorder(grey, sgm.CENSUS_H, sgm.CENSUS_H, sgm.CENSUS_W,
+                                          sgm.CENSUS_W, cv2.BORDER_REPLICATE))
+    want = _naive_paths(cost, 7, 90, dirs, grey, 8.0)
+    assert not np.array_equal(want, _naive_paths(cost, 7, 90, dirs))  # the steps matter here
+    np.testing.assert_array_equal(total, want)
+
+
+def test_adaptive_p2_falls_with_the_grey_step_from_p2_to_p1_plus_one() -> None:
+    table = sgm.penalty_table(18, 128, 16.0)
+    assert table[0] == 128 and table[16] == 64 and table[255] == 19
+    assert np.all(np.diff(table.astype(int)) <= 0)
+    assert np.all(sgm.penalty_table(18, 72, 0.0) == 72)
+    assert np.all(sgm.penalty_table(20, 20, 16.0) == 20)
 
 
 def test_five_path_lower_stripe_starts_its_paths_from_above_overlap_rows_up() -> None:
