@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pytest
 
+from host.api import StereoMatcher, load_params_file
 from host.commands.options import add_matcher_options, params_from_args
 from host.params_file import load_params, save_params
 from host.stereo.params import MatcherParams
@@ -58,3 +59,13 @@ def test_lr_check_off_in_a_file(tmp_path: Path) -> None:
     with pytest.raises(Exception, match="lr_check"):
         load_params(_file(tmp_path, '[matcher]\nmatcher = "sgm"\nlr_check = "on"\n'))
 
+
+def test_a_file_without_a_range_keeps_the_range_policy_in_the_api(tmp_path: Path) -> None:
+    """Neither [disparity_range] nor num_disparities: each pair gets its range from the policy
+    StereoMatcher.create uses (coarse), not the dataclass's 64; a fixed range stays fixed."""
+    path = _file(tmp_path, '[matcher]\nmatcher = "sgm"\n')
+    assert load_params_file(path).range_policy == RangePolicy.parse("coarse")
+    assert StereoMatcher.load(path).range_policy == RangePolicy.parse("coarse")
+    path = _file(tmp_path, '[matcher]\nmatcher = "sgm"\nnum_disparities = 32\n')
+    assert load_params_file(path).range_policy is None
+    assert load_params_file(path).params.num_disparities == 32
