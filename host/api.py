@@ -79,7 +79,8 @@ def check_pair(left: Any, right: Any) -> None:
 @dataclass(frozen=True)
 class ParamsFile:
     """A params file (host tune --out) as one object: the matcher parameters, the disparity
-    range policy it stores (None: the range is fixed in params) and its [tuning] record."""
+    range policy it stores (None: the range is fixed in params; a file with neither a policy
+    nor num_disparities gets create's default, coarse) and its [tuning] record."""
 
     params: MatcherParams
     range_policy: RangePolicy | None = None
@@ -88,10 +89,12 @@ class ParamsFile:
 
 def load_params_file(path: str | os.PathLike[str]) -> ParamsFile:
     """Read and validate a params file; HostError names the file and the problem."""
-    from host.params_file import load_disparity_range, load_params
+    from host.params_file import load_disparity_range, load_matcher_table, load_params
 
     params, tuning = load_params(path)
     table = load_disparity_range(path)
+    if table is None and "num_disparities" not in load_matcher_table(path):
+        return ParamsFile(params, RangePolicy.parse("coarse"), tuning)  # as create's default
     return ParamsFile(params, RangePolicy.from_table(table) if table else None, tuning)
 
 

@@ -40,7 +40,7 @@ def save_params(path: str | os.PathLike[str], params: MatcherParams,
     With disparity_range (a policy, host.tuning.disparity_range) the matcher table leaves out
     the range: the reader derives it from each scene or frame."""
     text = "# stereo-servo matcher parameters (host tune); read by host eval/servo --params\n"
-    matcher = params.to_dict()
+    matcher = params.to_dict() | ({"lr_check": "off"} if params.lr_check is None else {})
     if disparity_range:
         del matcher["num_disparities"], matcher["min_disparity"]
     text += _table("matcher", matcher)
@@ -52,7 +52,10 @@ def save_params(path: str | os.PathLike[str], params: MatcherParams,
 
 
 def load_params(path: str | os.PathLike[str]) -> tuple[MatcherParams, dict[str, Any]]:
-    """Read a params file; returns the validated matcher parameters and the [tuning] table."""
+    """Read a params file; returns the validated matcher parameters and the [tuning] table.
+
+    The [matcher] table's keys override its matcher's measured defaults
+    (MatcherParams.for_matcher); lr_check = "off" turns the LR check off."""
     p = Path(path)
     if p.is_dir():
         raise HostError(f"{p}: is a folder, not a params file")
@@ -86,8 +89,11 @@ def load_params(path: str | os.PathLike[str]) -> tuple[MatcherParams, dict[str, 
     for key, value in data["matcher"].items():
         if isinstance(value, float) and not math.isfinite(value):
             raise HostError(f"{p}: matcher parameter {key} must be a finite number, got {value}")
-    try:
-        params = MatcherParams.from_dict(data["matcher"]).validate()
+    table = data["matcher"] | ({"lr_check": None} if data["matcher"].get("lr_check") == "off"
+                               else {})
+    try:  # the keys over the named matcher's measured defaults, as the command line's
+        base = MatcherParams.for_matcher(table.get("matcher", MatcherParams.matcher))
+        params = MatcherParams.from_dict(table, base).validate()
     except HostError as e:
         raise HostError(f"{p}: {e}") from None
     except TypeError as e:

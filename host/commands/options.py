@@ -108,7 +108,8 @@ def add_old_spelling(g: argparse._ActionsContainer, old: str, new: argparse.Acti
 
 
 def add_matcher_options(p: argparse.ArgumentParser) -> None:
-    g = p.add_argument_group("matcher (defaults: --params file, else the built-in defaults)")
+    g = p.add_argument_group("matcher (defaults: the --matcher's measured ones; a --params file "
+                             "overrides them, the options override the file)")
     g.add_argument("--params", metavar="FILE", help="tuned parameters file (host tune --out)")
     g.add_argument("--matcher", choices=MATCHERS,
                    help="matching cost, or an OpenCV matcher; each starts from its measured "
@@ -152,8 +153,8 @@ _FIELDS = ("matcher", "block_size", "num_disparities", "min_disparity", "lr_chec
 
 
 def params_from_args(args: argparse.Namespace) -> MatcherParams:
-    """The --params file, else the --matcher's measured defaults (MatcherParams.for_matcher),
-    overridden by the options given on the command line."""
+    """The --params file (its keys over its matcher's measured defaults), else the --matcher's
+    measured defaults (MatcherParams.for_matcher), overridden by the options given."""
     if args.params:
         base = load_params(args.params)[0]
     else:

@@ -84,7 +84,8 @@ class MatcherParams:
         return {k: v for k, v in asdict(self).items() if v is not None}
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> MatcherParams:
+    def from_dict(cls, data: dict[str, Any], base: MatcherParams | None = None) -> MatcherParams:
+        """data's keys (type-checked) over base, else over the plain dataclass defaults."""
         known = {f.name for f in fields(cls)}
         unknown = sorted(set(data) - known)
         if unknown:
@@ -96,9 +97,12 @@ class MatcherParams:
                 continue
             if want is float and isinstance(value, int) and not isinstance(value, bool):
                 continue
+            if key == "lr_check":
+                raise HostError(f"matcher parameter lr_check must be a number (px) or "
+                                f"\"off\", got {value!r}")
             if not isinstance(value, want) or (want is int and isinstance(value, bool)):
                 raise HostError(f"matcher parameter {key} must be {want.__name__}, got {value!r}")
-        return cls(**data)
+        return replace(base, **data) if base is not None else cls(**data)
 
     def validate(self, width: int | None = None) -> MatcherParams:
         """Check bounds; width (px) also bounds the disparity range. Returns self."""
