@@ -52,6 +52,7 @@ from host.servo.perception import (
     Floor,
     StripMap,
     Target,
+    camera_height,
     fit_floor,
     fixed_cells,
     fixed_in_path,
@@ -140,6 +141,8 @@ class ServoConfig:
     rereference: bool = True  # and re-reference after the camera moved (checked against
     # the old reference moved by the picture's shift: rereference.py)
     moved_rows: float = 0.005  # of the focal length (0.3 degrees of pitch): the camera moved
+    camera_height_m: float = 0.25  # only where the reference shows no floor (a note says so):
+    # otherwise measured by the floor fit (perception.camera_height)
     acquire_tries: int = 3  # look-alikes that do not move, left out one after the other
     lane_width_px: int = 320  # the lane is watched on frames scaled down to about this width
     ring_ratio: float = RING_RATIO  # the marker's light ring, in disc radii (as printed)
@@ -215,6 +218,7 @@ class Servo:
         self.tracker: TargetTracker | None = None
         self.controller: Controller | None = None
         self.floor: Floor | None = None
+        self.camera_height_m = self.cfg.camera_height_m  # from the floor fit (reference)
         self.last_pair: MarkerPair | None = None  # the last admitted sighting
         self.rows: list[LogRow] = []
         self.last: Step | None = None
@@ -305,6 +309,7 @@ class Servo:
         self._strips = StripMap(self.params, (h, w))
         self._width = w
         target, self.floor = reference_target(disps, min_area)
+        self._measure_height(self.floor)
         self.reference_map = median_map(disps)
         k = self._lane_scale = max(1, w // self.cfg.lane_width_px)
         g = self.geometry
@@ -316,8 +321,20 @@ class Servo:
         self.controller.keep_out = self._extent(
             object_extent(without_floor(self.reference_map, self.floor), target))
         self.controller.fixed = fixed_cells(self.reference_map, self.geometry,
-                                            self.control.cell_m)
+                                            camera_height_m=self.camera_height_m,
+                                            cell_m=self.control.cell_m)
         return target
+
+    def _measure_height(self, floor: Floor | None) -> None:
+        """The camera's height above the floor from the floor fit (the lane's and the fixed
+        objects' heights are measured from it), or, with no floor in the picture, the
+        configured one, with a note."""
+        if floor is None:
+            self.notes.append(f"no floor in the reference: the camera's height taken as "
+                              f"{self.cfg.camera_height_m:.3f} m")
+            self.camera_height_m = self.cfg.camera_height_m
+        else:
+            self.camera_height_m = camera_height(floor, self.geometry.baseline_m)
 
     def _lane_map(self, reference: np.ndarray) -> np.ndarray:
         """A reference map at the lane's scale (its disparities scaled with it)."""
@@ -489,14 +506,16 @@ class Servo:
             left = cv2.resize(left, size, interpolation=cv2.INTER_AREA)
             right = cv2.resize(right, size, interpolation=cv2.INTER_AREA)
         h, w = left.shape[:2]
-        window = lane_window(g, (w, h), z, x, direction, reach)
+        window = lane_window(g, (w, h), z, x, direction, reach,
+                             camera_height_m=self.camera_height_m)
         if window is None:
             return ""
         disp = match_window(left, right, self.params, window)
         if self.last_pair is not None:  # the robot's own body (its texture mismatches)
             x0, y0, x1, y1 = self._robot_region(self.last_pair, frame.left.shape)
             disp[y0 // k:-(-y1 // k), x0 // k:-(-x1 // k)] = np.nan
-        found = lane_obstacle(disp, g, z, x, direction, reach, self._lane_reference)
+        found = lane_obstacle(disp, g, z, x, direction, reach, self._lane_reference,
+                              camera_height_m=self.camera_height_m)
         if found is None:
             return ""
         return f"an object in the lane {found.ahead_m:.2f} m ahead"
@@ -835,6 +854,7 @@ class Servo:
         k, lane = self._lane_scale, self._lane_geometry
         lane = dataclasses.replace(lane, cy=lane.cy + dy / k)  # the horizon moved
         self.floor, self.reference_map, self._lane_geometry = floor, reference, lane
+        self._measure_height(floor)  # a knock may have changed it too
         self._reference_image = reference_image(frame.left)
         self._lane_reference = self._lane_map(reference)
         self.tracker = TargetTracker(target, self.tracker.min_area, self.cfg.tracker)
@@ -845,7 +865,7 @@ class Servo:
         g = self.geometry
         self.controller.fixed = fixed_cells(
             reference, dataclasses.replace(g, cy=(lane.cy + 0.5) * k - 0.5),
-            self.control.cell_m)
+            camera_height_m=self.camera_height_m, cell_m=self.control.cell_m)
         assert self._strips is not None
         self._strips.reset()
         self._remeasure_t = None
