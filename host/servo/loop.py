@@ -780,13 +780,16 @@ class Servo:
         """Back the safe way: the estimator started afresh from sightings it gates (or, with
         keep_estimate, going on: its gate keeps the robot where it stood), the acquisition
         again (with a probe move where the heading may have changed), the controller's state
-        anew but for what it learnt of the object and the wheels."""
+        anew but for what it learnt of the object and the wheels. An acquisition the wait cut
+        short had not yet shown the marker to be the robot's (nor its heading): nothing of it
+        is kept, and it starts again with its probe."""
         assert self.controller is not None
         old = self.controller
-        if not keep_estimate:
+        proven = self.acquisition.done
+        if not (keep_estimate and proven):
             self.estimator.forget()
-        self.acquisition = Acquisition(self.cfg.acquire,
-                                       facing_away=None if probe else old.facing_away)
+        self.acquisition = Acquisition(self.cfg.acquire, facing_away=None if probe or not
+                                       proven else old.facing_away)
         c = Controller(old.target_m, self.control)
         c.cfg, c.keep_out, c.trim, c.facing_away = old.cfg, old.keep_out, old.trim, \
             old.facing_away
