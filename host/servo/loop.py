@@ -213,6 +213,9 @@ class Servo:
         self._lane_geometry = geometry
         self._lane_reference: np.ndarray | None = None
         self._reference_image: np.ndarray | None = None
+        # the target's latest picture (grey) and the robot's region in it, from the last
+        # re-measure that found the camera where it was: what a re-reference looks for
+        self._target_picture: tuple[np.ndarray, tuple[int, int, int, int] | None] | None = None
         self.estimator = Estimator(geometry, self.cfg.estimator)
         self.acquisition = Acquisition(self.cfg.acquire)
         self.tracker: TargetTracker | None = None
@@ -450,9 +453,10 @@ class Servo:
         hide = self._robot_region(robot_at, frame.left.shape)
         whole = self._strips.add(frame.left, frame.right, hide)
         if whole is not None:
-            self._remeasure(whole, frame)
+            self._remeasure(whole, frame, hide)
 
-    def _remeasure(self, disp: np.ndarray, frame: StereoFrame) -> None:
+    def _remeasure(self, disp: np.ndarray, frame: StereoFrame,
+                   hide: tuple[int, int, int, int] | None = None) -> None:
         """The tracker's measure on the whole map disp (the robot's region NaN); first, that
         the camera has not moved since the reference (the floor fit would no longer remove
         the floor, and its rows pass for the object): the floor off its line and the picture
@@ -466,6 +470,7 @@ class Servo:
                 self._reref, self._reref_fails = [], 0
                 self._recover(frame.t_left, MOVED, f"{moved} (the picture moved {dy:+.1f} rows)")
                 return
+        self._target_picture = (reference_image(frame.left), hide)
         clean = without_floor(disp, self.floor)
         before = self.tracker.target
         target = self.tracker.update(clean, lambda t: views_agree(
@@ -847,8 +852,10 @@ class Servo:
         except HostError as e:
             return str(e)
         agree = views_agree(frame.left, frame.right, target.bbox, target.disparity)
-        rows = target_shift_rows(self._reference_image, frame.left, old.bbox,
-                                 int(abs(dy)) + 4)
+        # the target's picture as the last re-measure saw it (the target may have moved since
+        # the reference phase, the robot stand in front of it), else the reference's
+        picture, hide = self._target_picture or (self._reference_image, None)
+        rows = target_shift_rows(picture, frame.left, old.bbox, int(abs(dy)) + 4, hide=hide)
         why = rereference_fault(self.floor, floor, dy, old, target, agree,
                                 moved_rows=self.cfg.moved_rows * self.geometry.focal_px,
                                 target_rows=rows)
@@ -859,6 +866,7 @@ class Servo:
         self.floor, self.reference_map, self._lane_geometry = floor, reference, lane
         self._measure_height(floor)  # a knock may have changed it too
         self._reference_image = reference_image(frame.left)
+        self._target_picture = (self._reference_image, robot)
         self._lane_reference = self._lane_map(reference)
         self.tracker = TargetTracker(target, self.tracker.min_area, self.cfg.tracker)
         self._targets_before.clear()
