@@ -858,7 +858,7 @@ class Servo:
         rows = target_shift_rows(picture, frame.left, old.bbox, int(abs(dy)) + 4, hide=hide)
         why = rereference_fault(self.floor, floor, dy, old, target, agree,
                                 moved_rows=self.cfg.moved_rows * self.geometry.focal_px,
-                                target_rows=rows)
+                                target_rows=rows, last=self.tracker.history[-1])
         if why:
             return why
         k, lane = self._lane_scale, self._lane_geometry

@@ -117,7 +117,7 @@ def target_shift_rows(reference: np.ndarray, image: np.ndarray, box: tuple[int, 
 
 def rereference_fault(old_floor: Floor | None, floor: Floor, shift_rows: float, old: Target,
                       new: Target, agreement: float, moved_rows: float = 0.0,
-                      target_rows: float | None = None,
+                      target_rows: float | None = None, last: float | None = None,
                       limits: RereferenceLimits = RereferenceLimits()) -> str:
     """Why a re-reference cannot be trusted ("" when it can): what it found (floor, the
     nearest object new, how well new's two views agree) against the old reference (old_floor,
@@ -128,7 +128,10 @@ def rereference_fault(old_floor: Floor | None, floor: Floor, shift_rows: float, 
     moment), the floor's slope kept, its horizon moved by the picture's shift, the target
     where the old one was (its region shifted by those rows overlapping the old by `overlap`
     across and down; and, target_rows given, its picture moved by the picture's shift:
-    target_shift_rows, NaN when not found), at its disparity, and agreeing in both views."""
+    target_shift_rows, NaN when not found), at its disparity (old's, the median of the
+    tracker's last measures, or last, the newest of them: a target that moved in depth shortly
+    before the knock has been measured there once or twice, and the median lags), and
+    agreeing in both views."""
     lim = limits
     if abs(shift_rows) < moved_rows:
         return (f"the picture did not move ({shift_rows:+.1f} rows): something stands over "
@@ -145,8 +148,10 @@ def rereference_fault(old_floor: Floor | None, floor: Floor, shift_rows: float, 
         return (f"the target's picture moved {target_rows:+.0f} rows where the picture moved "
                 f"{shift_rows:+.1f}" if math.isfinite(target_rows) else
                 "the target's picture is not where the picture's shift puts it")
-    tol = max(lim.disparity_px, lim.disparity_frac * old.disparity)
-    if not abs(new.disparity - old.disparity) <= tol:
+    def near(d: float) -> bool:
+        return abs(new.disparity - d) <= max(lim.disparity_px, lim.disparity_frac * d)
+
+    if not (near(old.disparity) or last is not None and near(last)):
         return (f"the nearest object is at {new.disparity:.2f} px, the target was at "
                 f"{old.disparity:.2f} px")
     ox, oy, ow, oh = old.bbox

@@ -149,3 +149,19 @@ def test_a_target_cut_by_the_pictures_side_is_matched_up_to_it():
     moved = (np.roll(scene, -11, axis=0) + rng.normal(0, 3, scene.shape)).astype(np.uint8)
     assert target_shift_rows(scene, moved, (246, 66, 74, 152), 15) == -11
     assert target_shift_rows(scene, moved, (0, 66, 74, 152), 15) == -11
+
+
+def test_a_target_measured_at_its_new_depth_just_before_the_knock_is_a_re_reference():
+    """The target box moved from 1.07 to 1.21 m; one re-measure saw it there (21.48 px) before
+    the knock, so the tracker's median still said 23.94 px. The re-reference finds it at
+    21.29 px where it was: the newest measure vouches for that depth. A depth neither the
+    median nor the newest measure had is still refused (the target moved during the wait)."""
+    old = Target(23.94, 854, (26, 147, 37, 60), 0.17)
+    floor = _pitched(OLD_FLOOR, -15.1)
+    new = Target(21.29, 9166, (26, 56, 73, 134), 0.16)
+    assert rereference_fault(OLD_FLOOR, floor, -15.1, old, new, 0.94).startswith(
+        "the nearest object is at 21.29 px, the target was at 23.94 px")
+    assert rereference_fault(OLD_FLOOR, floor, -15.1, old, new, 0.94, last=21.48) == ""
+    farther = Target(19.9, 9166, (26, 56, 73, 134), 0.16)
+    assert rereference_fault(OLD_FLOOR, floor, -15.1, old, farther, 0.94,
+                             last=21.48).startswith("the nearest object is at 19.90 px")
