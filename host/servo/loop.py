@@ -470,7 +470,11 @@ class Servo:
                 self._reref, self._reref_fails = [], 0
                 self._recover(frame.t_left, MOVED, f"{moved} (the picture moved {dy:+.1f} rows)")
                 return
-        self._target_picture = (reference_image(frame.left), hide)
+        if self._reference_image is not None and abs(vertical_shift_px(
+                self._reference_image, frame.left)) < self.cfg.moved_rows * self.geometry.focal_px:
+            # the target's picture while the camera is where it was (a moved camera that the
+            # floor did not show yet must not give the picture the knock is measured against)
+            self._target_picture = (reference_image(frame.left), hide)
         clean = without_floor(disp, self.floor)
         before = self.tracker.target
         target = self.tracker.update(clean, lambda t: views_agree(
