@@ -52,6 +52,7 @@ from host.servo.perception import (
     Floor,
     StripMap,
     Target,
+    camera_height,
     fit_floor,
     fixed_cells,
     fixed_in_path,
@@ -140,6 +141,8 @@ class ServoConfig:
     rereference: bool = True  # and re-reference after the camera moved (checked against
     # the old reference moved by the picture's shift: rereference.py)
     moved_rows: float = 0.005  # of the focal length (0.3 degrees of pitch): the camera moved
+    camera_height_m: float = 0.25  # only where the reference shows no floor (a note says so):
+    # otherwise measured by the floor fit (perception.camera_height)
     acquire_tries: int = 3  # look-alikes that do not move, left out one after the other
     lane_width_px: int = 320  # the lane is watched on frames scaled down to about this width
     ring_ratio: float = RING_RATIO  # the marker's light ring, in disc radii (as printed)
@@ -210,11 +213,15 @@ class Servo:
         self._lane_geometry = geometry
         self._lane_reference: np.ndarray | None = None
         self._reference_image: np.ndarray | None = None
+        # the target's latest picture (grey) and the robot's region in it, from the last
+        # re-measure that found the camera where it was: what a re-reference looks for
+        self._target_picture: tuple[np.ndarray, tuple[int, int, int, int] | None] | None = None
         self.estimator = Estimator(geometry, self.cfg.estimator)
         self.acquisition = Acquisition(self.cfg.acquire)
         self.tracker: TargetTracker | None = None
         self.controller: Controller | None = None
         self.floor: Floor | None = None
+        self.camera_height_m = self.cfg.camera_height_m  # from the floor fit (reference)
         self.last_pair: MarkerPair | None = None  # the last admitted sighting
         self.rows: list[LogRow] = []
         self.last: Step | None = None
@@ -305,6 +312,7 @@ class Servo:
         self._strips = StripMap(self.params, (h, w))
         self._width = w
         target, self.floor = reference_target(disps, min_area)
+        self._measure_height(self.floor)
         self.reference_map = median_map(disps)
         k = self._lane_scale = max(1, w // self.cfg.lane_width_px)
         g = self.geometry
@@ -316,8 +324,20 @@ class Servo:
         self.controller.keep_out = self._extent(
             object_extent(without_floor(self.reference_map, self.floor), target))
         self.controller.fixed = fixed_cells(self.reference_map, self.geometry,
-                                            self.control.cell_m)
+                                            camera_height_m=self.camera_height_m,
+                                            cell_m=self.control.cell_m)
         return target
+
+    def _measure_height(self, floor: Floor | None) -> None:
+        """The camera's height above the floor from the floor fit (the lane's and the fixed
+        objects' heights are measured from it), or, with no floor in the picture, the
+        configured one, with a note."""
+        if floor is None:
+            self.notes.append(f"no floor in the reference: the camera's height taken as "
+                              f"{self.cfg.camera_height_m:.3f} m")
+            self.camera_height_m = self.cfg.camera_height_m
+        else:
+            self.camera_height_m = camera_height(floor, self.geometry.baseline_m)
 
     def _lane_map(self, reference: np.ndarray) -> np.ndarray:
         """A reference map at the lane's scale (its disparities scaled with it)."""
@@ -433,9 +453,10 @@ class Servo:
         hide = self._robot_region(robot_at, frame.left.shape)
         whole = self._strips.add(frame.left, frame.right, hide)
         if whole is not None:
-            self._remeasure(whole, frame)
+            self._remeasure(whole, frame, hide)
 
-    def _remeasure(self, disp: np.ndarray, frame: StereoFrame) -> None:
+    def _remeasure(self, disp: np.ndarray, frame: StereoFrame,
+                   hide: tuple[int, int, int, int] | None = None) -> None:
         """The tracker's measure on the whole map disp (the robot's region NaN); first, that
         the camera has not moved since the reference (the floor fit would no longer remove
         the floor, and its rows pass for the object): the floor off its line and the picture
@@ -449,6 +470,11 @@ class Servo:
                 self._reref, self._reref_fails = [], 0
                 self._recover(frame.t_left, MOVED, f"{moved} (the picture moved {dy:+.1f} rows)")
                 return
+        if self._reference_image is not None and abs(vertical_shift_px(
+                self._reference_image, frame.left)) < self.cfg.moved_rows * self.geometry.focal_px:
+            # the target's picture while the camera is where it was (a moved camera that the
+            # floor did not show yet must not give the picture the knock is measured against)
+            self._target_picture = (reference_image(frame.left), hide)
         clean = without_floor(disp, self.floor)
         before = self.tracker.target
         target = self.tracker.update(clean, lambda t: views_agree(
@@ -489,14 +515,16 @@ class Servo:
             left = cv2.resize(left, size, interpolation=cv2.INTER_AREA)
             right = cv2.resize(right, size, interpolation=cv2.INTER_AREA)
         h, w = left.shape[:2]
-        window = lane_window(g, (w, h), z, x, direction, reach)
+        window = lane_window(g, (w, h), z, x, direction, reach,
+                             camera_height_m=self.camera_height_m)
         if window is None:
             return ""
         disp = match_window(left, right, self.params, window)
         if self.last_pair is not None:  # the robot's own body (its texture mismatches)
             x0, y0, x1, y1 = self._robot_region(self.last_pair, frame.left.shape)
             disp[y0 // k:-(-y1 // k), x0 // k:-(-x1 // k)] = np.nan
-        found = lane_obstacle(disp, g, z, x, direction, reach, self._lane_reference)
+        found = lane_obstacle(disp, g, z, x, direction, reach, self._lane_reference,
+                              camera_height_m=self.camera_height_m)
         if found is None:
             return ""
         return f"an object in the lane {found.ahead_m:.2f} m ahead"
@@ -761,13 +789,16 @@ class Servo:
         """Back the safe way: the estimator started afresh from sightings it gates (or, with
         keep_estimate, going on: its gate keeps the robot where it stood), the acquisition
         again (with a probe move where the heading may have changed), the controller's state
-        anew but for what it learnt of the object and the wheels."""
+        anew but for what it learnt of the object and the wheels. An acquisition the wait cut
+        short had not yet shown the marker to be the robot's (nor its heading): nothing of it
+        is kept, and it starts again with its probe."""
         assert self.controller is not None
         old = self.controller
-        if not keep_estimate:
+        proven = self.acquisition.done
+        if not (keep_estimate and proven):
             self.estimator.forget()
-        self.acquisition = Acquisition(self.cfg.acquire,
-                                       facing_away=None if probe else old.facing_away)
+        self.acquisition = Acquisition(self.cfg.acquire, facing_away=None if probe or not
+                                       proven else old.facing_away)
         c = Controller(old.target_m, self.control)
         c.cfg, c.keep_out, c.trim, c.facing_away = old.cfg, old.keep_out, old.trim, \
             old.facing_away
@@ -825,17 +856,21 @@ class Servo:
         except HostError as e:
             return str(e)
         agree = views_agree(frame.left, frame.right, target.bbox, target.disparity)
-        rows = target_shift_rows(self._reference_image, frame.left, old.bbox,
-                                 int(abs(dy)) + 4)
+        # the target's picture as the last re-measure saw it (the target may have moved since
+        # the reference phase, the robot stand in front of it), else the reference's
+        picture, hide = self._target_picture or (self._reference_image, None)
+        rows = target_shift_rows(picture, frame.left, old.bbox, int(abs(dy)) + 4, hide=hide)
         why = rereference_fault(self.floor, floor, dy, old, target, agree,
                                 moved_rows=self.cfg.moved_rows * self.geometry.focal_px,
-                                target_rows=rows)
+                                target_rows=rows, last=self.tracker.history[-1])
         if why:
             return why
         k, lane = self._lane_scale, self._lane_geometry
         lane = dataclasses.replace(lane, cy=lane.cy + dy / k)  # the horizon moved
         self.floor, self.reference_map, self._lane_geometry = floor, reference, lane
+        self._measure_height(floor)  # a knock may have changed it too
         self._reference_image = reference_image(frame.left)
+        self._target_picture = (self._reference_image, robot)
         self._lane_reference = self._lane_map(reference)
         self.tracker = TargetTracker(target, self.tracker.min_area, self.cfg.tracker)
         self._targets_before.clear()
@@ -845,7 +880,7 @@ class Servo:
         g = self.geometry
         self.controller.fixed = fixed_cells(
             reference, dataclasses.replace(g, cy=(lane.cy + 0.5) * k - 0.5),
-            self.control.cell_m)
+            camera_height_m=self.camera_height_m, cell_m=self.control.cell_m)
         assert self._strips is not None
         self._strips.reset()
         self._remeasure_t = None

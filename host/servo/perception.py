@@ -71,6 +71,15 @@ def fit_floor(disp: np.ndarray, min_slope: float = 0.02) -> Floor | None:
     return Floor(float(slope), float(offset)) if slope > min_slope else None
 
 
+def camera_height(floor: Floor, baseline_m: float) -> float:
+    """The camera's optical centre above the floor (m), from the floor fit: a floor point at
+    row y shows d = B ((y - cy) cos p + f sin p) / h for a rig at height h pitched down by p,
+    so the fit's slope is B cos p / h (h = B / slope within 0.06 % at 2 degrees of pitch). One
+    source for the height every lane and fixed-object test measures from: a rig set up at
+    another height, or knocked to a new one, is measured, not assumed."""
+    return baseline_m / floor.slope
+
+
 def without_floor(disp: np.ndarray, floor: Floor | None, tol_px: float = 1.0) -> np.ndarray:
     """disp with the floor's pixels set to NaN."""
     if floor is None:
@@ -337,13 +346,14 @@ class LaneWindow:
 
 
 def lane_window(geometry: Geometry, size: tuple[int, int], depth_m: float, lateral_m: float,
-                direction: int, reach_m: float, half_width_m: float = 0.12,
-                body_m: float = 0.10, height_m: float = 0.30, camera_height_m: float = 0.25
+                direction: int, reach_m: float, *, camera_height_m: float,
+                half_width_m: float = 0.12, body_m: float = 0.10, height_m: float = 0.30
                 ) -> LaneWindow | None:
     """Where to watch the lane: the stretch from body_m to body_m + reach_m ahead of the robot's
     centre (direction +1: moving away from the camera, -1: toward it), half_width_m each side
     of its line (x = lateral_m), from the floor to height_m. depth_m, lateral_m: the robot's
-    (m, from its marker); size: (width, height) of the picture. None when the stretch leaves
+    (m, from its marker); size: (width, height) of the picture; camera_height_m: the camera's
+    optical centre above the floor (camera_height). None when the stretch leaves
     the camera's near range (nearer than 0.25 m) or the picture. Match this box with the
     window's range (match_window), then lane_obstacle on the map."""
     w, h = size
@@ -393,24 +403,25 @@ class LaneObstacle:
 
 
 def lane_obstacle(disp: np.ndarray, geometry: Geometry, depth_m: float, lateral_m: float,
-                  direction: int, reach_m: float, reference: np.ndarray | None = None,
-                  half_width_m: float = 0.12, body_m: float = 0.10, floor_clear_m: float = 0.03,
-                  height_m: float = 0.30, camera_height_m: float = 0.25, tol_px: float = 1.0,
+                  direction: int, reach_m: float, reference: np.ndarray | None = None, *,
+                  camera_height_m: float, half_width_m: float = 0.12, body_m: float = 0.10,
+                  floor_clear_m: float = 0.03, height_m: float = 0.30, tol_px: float = 1.0,
                   min_size_m: float = 0.04, robot_px: int = 4) -> LaneObstacle | None:
     """An object in the robot's lane within reach_m ahead of its front, or None.
 
     Each valid pixel of disp is a point in the world (x = B (u - cx) / d, z = f B / d, height
-    above the floor = camera_height_m - B (v - cy) / d). Counted: points in the stretch from
-    body_m to body_m + reach_m ahead of the robot's centre (depth_m, direction +1 away from the
-    camera, -1 toward it), within half_width_m of its line (lateral_m), higher than
-    floor_clear_m above the floor (the floor is never an obstacle, whatever the floor fit
-    says) and below height_m, not within robot_px of a pixel at the robot's own disparity
-    (the mismatches along its silhouette), and, with a reference map (the scene without the
-    robot, same geometry), nearer than what the reference had there by tol_px (the object the
-    robot drives to and the wall are not new). The largest connected patch of such pixels, if
-    it covers at least a min_size_m square at its depth ((min_size_m f / z)^2 px; at least 25):
-    the obstacle, at its median depth. Moving away from the camera
-    the robot hides what is right behind it: a low object is seen only beside or above it.
+    above the floor = camera_height_m - B (v - cy) / d, camera_height_m from the floor fit:
+    camera_height). Counted: points in the stretch from body_m to body_m + reach_m ahead of
+    the robot's centre (depth_m, direction +1 away from the camera, -1 toward it), within
+    half_width_m of its line (lateral_m), higher than floor_clear_m above the floor (the
+    floor is never an obstacle, whatever the floor fit says) and below height_m, not within
+    robot_px of a pixel at the robot's own disparity (the mismatches along its silhouette),
+    and, with a reference map (the scene without the robot, same geometry), nearer than what
+    the reference had there by tol_px (the object the robot drives to and the wall are not
+    new). The largest connected patch of such pixels, if it covers at least a min_size_m
+    square at its depth ((min_size_m f / z)^2 px; at least 25): the obstacle, at its median
+    depth. Moving away from the camera the robot hides what is right behind it: a low object
+    is seen only beside or above it.
 
     A result (not None) means: stop now, before it closes; reach_m is the stopping distance at
     the current speed (stopping_distance_m) plus any margin.
@@ -450,19 +461,20 @@ def lane_obstacle(disp: np.ndarray, geometry: Geometry, depth_m: float, lateral_
     return LaneObstacle(zm, (zm - depth_m) * direction, area)
 
 
-def fixed_cells(disp: np.ndarray, geometry: Geometry, cell_m: float = 0.02,
-                min_height_m: float = 0.05, floor_clear_m: float = 0.03, height_m: float = 0.30,
-                camera_height_m: float = 0.25) -> np.ndarray:
+def fixed_cells(disp: np.ndarray, geometry: Geometry, *, camera_height_m: float,
+                cell_m: float = 0.02, min_height_m: float = 0.05, floor_clear_m: float = 0.03,
+                height_m: float = 0.30) -> np.ndarray:
     """Where the scene's fixed objects stand, seen from above: the (depth, lateral) centres (m)
     of the cell_m x cell_m floor cells that hold an upright face, as an (n, 2) array. A cell's
     points are those of the map between floor_clear_m and height_m above the floor (the
     robot's height; the floor is never an object); it holds a face when they rise at least
     min_height_m, span two image columns or more, and number at least half of what a face
     cell_m wide and min_height_m tall at that depth shows. disp: the reference map (the scene
-    without the robot, px, NaN invalid). A box's front face fills each cell it stands on with
-    hundreds of points; a mismatch (the near floor beyond the search range, the first valid
-    column) puts a few dozen in a small patch or a single column. The target is among them
-    (the controller leaves its extent to the keep-out)."""
+    without the robot, px, NaN invalid); camera_height_m: from the floor fit (camera_height).
+    A box's front face fills each cell it stands on with hundreds of points; a mismatch (the
+    near floor beyond the search range, the first valid column) puts a few dozen in a small
+    patch or a single column. The target is among them (the controller leaves its extent to
+    the keep-out)."""
     g = geometry
     with np.errstate(invalid="ignore"):
         vs, us = np.nonzero(np.isfinite(disp) & (disp > 0.5))

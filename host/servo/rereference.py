@@ -80,29 +80,44 @@ class RereferenceLimits:
 
 
 def target_shift_rows(reference: np.ndarray, image: np.ndarray, box: tuple[int, int, int, int],
-                      max_rows: int, max_cols: int = 4, min_score: float = 0.25) -> float:
+                      max_rows: int, max_cols: int = 4, min_score: float = 0.25,
+                      hide: tuple[int, int, int, int] | None = None) -> float:
     """How many rows (positive: down) the picture of the region box (x, y, w, h) of reference
-    (rig.reference_image: grey float32) moved in image: the best normalised correlation of the
-    region within max_rows up or down and max_cols across. NaN when the best scores below
-    min_score (the region's picture is not there: it was replaced, or something stands in
-    front of it) or the search leaves the picture. A pitch warps the picture a little and the
-    sensor's noise is new: a box's front knocked 1.8 degrees scored 0.37-0.49 at its shifted
-    place and under 0.1 elsewhere (dev seed 8's trial 45)."""
+    (a picture of the target before the camera moved, rig.reference_image: grey float32)
+    moved in image: the best normalised correlation of the region within max_rows up or down
+    and max_cols across (within the picture), the pixels of hide (x0, y0, x1, y1: the robot
+    where it stood in reference) left out. NaN when the best scores below min_score (the
+    region's picture is not there: it was replaced, or something stands in front of it), when
+    hide leaves less than a quarter of the region, or when the search up or down leaves the
+    picture. A pitch warps the picture a little and the sensor's noise is new: a box's front
+    knocked 1.8 degrees scored 0.37-0.49 at its shifted place and under 0.1 elsewhere (dev
+    seed 8's trial 45)."""
     grey = to_grey(image).astype(np.float32)
     h, w = grey.shape
     x, y, bw, bh = box
-    y0, y1, x0, x1 = y - max_rows, y + bh + max_rows, x - max_cols, x + bw + max_cols
-    if bw < 8 or bh < 8 or y0 < 0 or x0 < 0 or y1 > h or x1 > w:
+    # across, the search stops at the picture's sides (a region cut by the picture's edge
+    # reaches it); down, it must reach max_rows both ways
+    y0, y1, x0, x1 = y - max_rows, y + bh + max_rows, max(0, x - max_cols), \
+        min(w, x + bw + max_cols)
+    if bw < 8 or bh < 8 or y0 < 0 or y1 > h or x < 0 or x + bw > w:
         return math.nan
-    scores = cv2.matchTemplate(grey[y0:y1, x0:x1], reference[y:y + bh, x:x + bw],
-                               cv2.TM_CCOEFF_NORMED)
+    template = reference[y:y + bh, x:x + bw]
+    mask = np.ones_like(template)
+    if hide is not None:
+        hx0, hy0, hx1, hy1 = hide
+        mask[max(0, hy0 - y):max(0, hy1 - y), max(0, hx0 - x):max(0, hx1 - x)] = 0
+        if mask.sum() < mask.size / 4:
+            return math.nan
+    scores = cv2.matchTemplate(grey[y0:y1, x0:x1], template, cv2.TM_CCOEFF_NORMED,
+                               mask=mask if hide is not None else None)
+    scores[~np.isfinite(scores)] = -1.0
     _, best, _, (_, row) = cv2.minMaxLoc(scores)
     return float(row - max_rows) if best >= min_score else math.nan
 
 
 def rereference_fault(old_floor: Floor | None, floor: Floor, shift_rows: float, old: Target,
                       new: Target, agreement: float, moved_rows: float = 0.0,
-                      target_rows: float | None = None,
+                      target_rows: float | None = None, last: float | None = None,
                       limits: RereferenceLimits = RereferenceLimits()) -> str:
     """Why a re-reference cannot be trusted ("" when it can): what it found (floor, the
     nearest object new, how well new's two views agree) against the old reference (old_floor,
@@ -113,7 +128,10 @@ def rereference_fault(old_floor: Floor | None, floor: Floor, shift_rows: float, 
     moment), the floor's slope kept, its horizon moved by the picture's shift, the target
     where the old one was (its region shifted by those rows overlapping the old by `overlap`
     across and down; and, target_rows given, its picture moved by the picture's shift:
-    target_shift_rows, NaN when not found), at its disparity, and agreeing in both views."""
+    target_shift_rows, NaN when not found), at its disparity (old's, the median of the
+    tracker's last measures, or last, the newest of them: a target that moved in depth shortly
+    before the knock has been measured there once or twice, and the median lags), and
+    agreeing in both views."""
     lim = limits
     if abs(shift_rows) < moved_rows:
         return (f"the picture did not move ({shift_rows:+.1f} rows): something stands over "
@@ -130,8 +148,10 @@ def rereference_fault(old_floor: Floor | None, floor: Floor, shift_rows: float, 
         return (f"the target's picture moved {target_rows:+.0f} rows where the picture moved "
                 f"{shift_rows:+.1f}" if math.isfinite(target_rows) else
                 "the target's picture is not where the picture's shift puts it")
-    tol = max(lim.disparity_px, lim.disparity_frac * old.disparity)
-    if not abs(new.disparity - old.disparity) <= tol:
+    def near(d: float) -> bool:
+        return abs(new.disparity - d) <= max(lim.disparity_px, lim.disparity_frac * d)
+
+    if not (near(old.disparity) or last is not None and near(last)):
         return (f"the nearest object is at {new.disparity:.2f} px, the target was at "
                 f"{old.disparity:.2f} px")
     ox, oy, ow, oh = old.bbox

@@ -110,10 +110,12 @@ def scene(robot_z: float, robot_x: float = 0.0, lane_box: float | None = None,
 
 def watch(world: World, left, right, reference, reach: float, direction: int = 1):
     g, r = world.geometry, world.robot
-    win = lane_window(g, world.size, r.z_m, r.x_m, direction, reach)
+    win = lane_window(g, world.size, r.z_m, r.x_m, direction, reach,
+                      camera_height_m=world.height_m)
     assert win is not None
     disp = match_window(left, right, PARAMS, win)
-    return lane_obstacle(disp, g, r.z_m, r.x_m, direction, reach, reference)
+    return lane_obstacle(disp, g, r.z_m, r.x_m, direction, reach, reference,
+                         camera_height_m=world.height_m)
 
 
 @pytest.mark.parametrize("width", [0.3, 0.6])
@@ -146,8 +148,8 @@ def test_toward_the_camera_the_stretch_nearer_than_the_robot_is_watched() -> Non
 
 def test_no_window_where_the_stretch_reaches_the_camera() -> None:
     g = World().geometry
-    assert lane_window(g, (320, 240), 0.4, 0.0, -1, 0.3) is None
-    win = lane_window(g, (320, 240), 0.8, 0.0, 1, 0.3)
+    assert lane_window(g, (320, 240), 0.4, 0.0, -1, 0.3, camera_height_m=0.25) is None
+    win = lane_window(g, (320, 240), 0.8, 0.0, 1, 0.3, camera_height_m=0.25)
     assert win is not None and win.min_disparity <= win.d_far < win.d_near <= (
         win.min_disparity + win.num_disparities)
     assert math.isclose(win.d_near, g.focal_px * g.baseline_m / 0.9)
@@ -171,7 +173,7 @@ def test_fixed_cells_are_the_boxes_faces_not_the_floors_mismatches() -> None:
     world = World(seed=3)
     f = Renderer(world, seed=3).frame(with_robot=False)
     disp = compute_disparity(f.left, match_exposure(f.left, f.right), PARAMS)
-    cells = fixed_cells(disp, world.geometry)
+    cells = fixed_cells(disp, world.geometry, camera_height_m=world.height_m)
     assert not (cells[:, 0] < 1.1).any(), cells[cells[:, 0] < 1.1]
     box = cells[np.abs(cells[:, 0] - 1.8) < 0.05]
     assert box[:, 1].min() < 0.25 and box[:, 1].max() > 0.50

@@ -121,3 +121,47 @@ def test_a_target_whose_picture_did_not_move_with_the_picture_is_no_re_reference
     why = rereference_fault(OLD_FLOOR, floor, -18.2, old, new, 0.9, target_rows=float("nan"))
     assert why == "the target's picture is not where the picture's shift puts it", why
     assert rereference_fault(OLD_FLOOR, floor, -18.2, old, new, 0.9, target_rows=-18.0) == ""
+
+
+def test_the_robots_region_of_the_targets_picture_is_left_out_of_the_match():
+    """The target's last picture shows the robot in front of part of it; by the knock the
+    robot has driven on, so the shifted region shows the box there: matched with the robot's
+    pixels the best place scores too low, left out the box is found moved with the picture."""
+    rng = np.random.default_rng(3)
+    scene = cv2.GaussianBlur(rng.uniform(0, 255, (240, 320)).astype(np.float32), (5, 5), 1.5)
+    box = (40, 80, 80, 70)
+    picture = scene.copy()
+    robot = (40, 80, 100, 150)  # x0, y0, x1, y1: three quarters of the region's width
+    picture[80:150, 40:100] = rng.uniform(0, 255, (70, 60)).astype(np.float32)
+    moved = np.roll(scene, -13, axis=0) + rng.normal(0, 3, scene.shape).astype(np.float32)
+    image = moved.astype(np.uint8)
+    assert np.isnan(target_shift_rows(picture, image, box, 17))
+    assert target_shift_rows(picture, image, box, 17, hide=robot) == -13
+    # a robot hiding more than three quarters of the region leaves too little to tell
+    assert np.isnan(target_shift_rows(picture, image, box, 17, hide=(30, 70, 130, 160)))
+
+
+def test_a_target_cut_by_the_pictures_side_is_matched_up_to_it():
+    """A box reaching the picture's right side: its region ends at the last column, and the
+    search across stops there (before, a search 4 columns past the side was NaN)."""
+    rng = np.random.default_rng(4)
+    scene = cv2.GaussianBlur(rng.uniform(0, 255, (240, 320)).astype(np.float32), (5, 5), 1.5)
+    moved = (np.roll(scene, -11, axis=0) + rng.normal(0, 3, scene.shape)).astype(np.uint8)
+    assert target_shift_rows(scene, moved, (246, 66, 74, 152), 15) == -11
+    assert target_shift_rows(scene, moved, (0, 66, 74, 152), 15) == -11
+
+
+def test_a_target_measured_at_its_new_depth_just_before_the_knock_is_a_re_reference():
+    """The target box moved from 1.07 to 1.21 m; one re-measure saw it there (21.48 px) before
+    the knock, so the tracker's median still said 23.94 px. The re-reference finds it at
+    21.29 px where it was: the newest measure vouches for that depth. A depth neither the
+    median nor the newest measure had is still refused (the target moved during the wait)."""
+    old = Target(23.94, 854, (26, 147, 37, 60), 0.17)
+    floor = _pitched(OLD_FLOOR, -15.1)
+    new = Target(21.29, 9166, (26, 56, 73, 134), 0.16)
+    assert rereference_fault(OLD_FLOOR, floor, -15.1, old, new, 0.94).startswith(
+        "the nearest object is at 21.29 px, the target was at 23.94 px")
+    assert rereference_fault(OLD_FLOOR, floor, -15.1, old, new, 0.94, last=21.48) == ""
+    farther = Target(19.9, 9166, (26, 56, 73, 134), 0.16)
+    assert rereference_fault(OLD_FLOOR, floor, -15.1, old, farther, 0.94,
+                             last=21.48).startswith("the nearest object is at 19.90 px")

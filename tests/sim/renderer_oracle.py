@@ -80,6 +80,7 @@ class Renderer:
         self.seed = seed
         self._static_key: tuple | None = None
         self._static: list[tuple[np.ndarray, np.ndarray]] = []
+        self._box_tex: dict[tuple[float, float, float], np.ndarray] = {}
         self._body_tex = random_texture(np.random.default_rng(seed + 1), 64, 64, 1.2, 45, 110)
         self._person_tex = random_texture(np.random.default_rng(seed + 2), 256, 256, 2.0, 50, 120)
         self.pitch_deg = 0.0  # the rig's pitch since it was calibrated (a knock)
@@ -118,8 +119,9 @@ class Renderer:
         fb = g.focal_px * g.baseline_m
         margin = int(fb / 0.5) + 8
 
-        def tex(sigma: float, contrast: float, mean: float) -> np.ndarray:
-            t = random_texture(rng, h, w + 2 * margin, sigma, contrast, mean)
+        def tex(sigma: float, contrast: float, mean: float,
+                t: np.ndarray | None = None) -> np.ndarray:
+            t = random_texture(rng, h, w + 2 * margin, sigma, contrast, mean) if t is None else t
             if not pad:
                 return t
             above, below = (random_texture(extra, pad, w + 2 * margin, sigma, contrast, mean)
@@ -141,10 +143,16 @@ class Renderer:
         if pad:
             layers.append(Layer(floor_d0, floor_tex, margin, dy=floor_dy,
                                 box=(-1e4, h + pad, 1e4, 1e4)))
+        first = not self._box_tex  # a box keeps its texture (host/sim/renderer.py)
         for b in sorted(world.boxes, key=lambda b: -b.z_m):
             x0, y0 = world.project(b.x0_m, b.height_m, b.z_m)
             x1, y1 = world.project(b.x1_m, 0.0, b.z_m)
-            layers.append(Layer(fb / b.z_m, tex(1.0, 55, 140), margin,
+            key = (b.x0_m, b.x1_m, b.height_m)
+            if key not in self._box_tex:
+                own = rng if first else np.random.default_rng(
+                    [self.seed, 4, len(self._box_tex)])
+                self._box_tex[key] = random_texture(own, h, w + 2 * margin, 1.0, 55, 140)
+            layers.append(Layer(fb / b.z_m, tex(1.0, 55, 140, self._box_tex[key]), margin,
                                 box=(x0, y0 + pad, x1, y1 + pad)))
         return [render_view(layers, w, h + 2 * pad, s)[:2] for s in (0.0, 1.0)]
 

@@ -101,14 +101,17 @@ def test_a_look_alike_that_replaced_the_target_during_a_knock_is_no_re_reference
     """The rig is knocked while the target box (1.2 m, left of the lane) is taken away and a
     box appears right of the lane at its depth: the nearest object after the knock, within the
     10 % of disparity the re-reference allowed before, which took it for the target and drove
-    the robot to it. It is not where the target was, moved with the picture: the robot stays
-    stopped and the run ends naming why."""
+    the robot to it. It is not where the target was, moved with the picture, and the target's
+    own picture is gone (the first check to say so, since the picture is taken from the last
+    re-measure and the reference no longer faded by the phase correlation's window): the robot
+    stays stopped and the run ends naming why."""
     events = (Event(2.0, "knock", angle_deg=1.5), Event(2.0, "vanish", 0),
               Event(2.0, "appear", box=(1.2, 0.25, 0.5, 0.38)))
     r = run(events)
     assert r.how == "stopped", (r.how, r.reason, r.notes)
     assert "re-referencing failed: the nearest object is not where the target was" in \
-        r.reason, r.reason
+        r.reason or "re-referencing failed: the target's picture is not where the " \
+        "picture's shift puts it" in r.reason, r.reason
     assert not any(n.startswith("re-referenced") for n in r.notes), r.notes
 
 
@@ -122,3 +125,16 @@ def test_a_knock_with_the_marker_hidden_ends_the_run_at_the_moved_bound():
     assert r.how == "stopped", (r.how, r.reason, r.notes)
     assert "the camera moved since the reference" in r.reason, r.reason
     assert r.reason.endswith("for 10 s"), r.reason
+
+
+def test_a_knock_after_a_nearer_object_became_the_target_is_re_referenced():
+    """A box put down at 1.05 m right of the lane becomes the target (nearer than the one at
+    1.2 m); then the rig is knocked. The reference phase's picture has only the wall and the
+    floor where the new target stands: its picture is looked for in the last re-measure's
+    frame instead (before, "the target's picture is not where the picture's shift puts it"
+    and the run ended)."""
+    r = run((Event(0.5, "appear", box=(1.05, 0.25, 0.5, 0.38)),
+             Event(6.0, "knock", angle_deg=1.5)), seconds=30.0)
+    assert any(n.startswith("a nearer object appeared") for n in r.notes), r.notes
+    _held(r, MOVED)
+    assert any(n.startswith("re-referenced after the camera moved") for n in r.notes), r.notes
