@@ -11,7 +11,8 @@ way the robot faces by what a short probe move does (a pure state machine, one c
              the marker has moved probe_m in depth (and three times its noise, the median of
              the last five sightings against the first five's; after probe_s two): the way
              it faces follows from the sign of that move; nothing moved by probe_s: the run
-             stops with that reason; moved, but not clearly in depth: on to probe_long_s
+             stops with that reason; moved, but not clearly in depth: on to probe_long_s;
+             the marker unseen for probe_gap_s (the robot stands): the probe begins again
              (skipped in a re-acquisition that knows the heading: done after the measure)
     a find that fails in a re-acquisition (again: why) says so: "not found again", not
     "never seen"
@@ -45,6 +46,7 @@ class AcquireConfig:
     probe_s: float = 1.5  # a robot that can move has moved by then
     probe_long_s: float = 2.5  # a move not yet clear in depth is probed on this long
     probe_max_m: float = 0.08  # or until the sighting has moved this far
+    probe_gap_s: float = 0.3  # the marker unseen this long in the probe: it begins again
 
 
 @dataclass(frozen=True)
@@ -138,6 +140,12 @@ class Acquisition:
         cfg = self.cfg
         if position is None:
             return Order(0, 0, Phase.PROBE)  # not seen: stand until it is
+        if t - (self._track[-1][0] if self._track else self._t0) > cfg.probe_gap_s:
+            # unseen meanwhile (hidden by something passing), standing: the probe begins
+            # again; timed on, it would find that the marker "did not move" and leave the true
+            # marker out as a look-alike (dev seed 104's trial 61: "never seen")
+            self._track.clear()
+            self._t0 = t
         self._track.append((t, *position))
         late, moved, dz = t - self._t0 > cfg.probe_s, 0.0, 0.0
         if len(self._track) >= 10:

@@ -182,3 +182,28 @@ def test_the_probe_decides_the_heading_by_the_move_in_depth_not_a_sideways_wobbl
         z -= 0.004
         acq.update(t, (z, 0.0), 12.0, noise_m=0.01)
     assert acq.done and acq.facing_away is True
+
+
+def test_a_marker_hidden_during_the_probe_is_no_look_alike() -> None:
+    """Hidden for 1.4 s just after the probe began (the robot stands, unseen): the probe begins
+    again when it is back, instead of timing on through the gap and finding that the marker
+    "did not move" (dev seed 104's trial 61 then left the true marker out as a look-alike and
+    ended "the marker was never seen")."""
+    acq = Acquisition(AcquireConfig())
+    t = 0.0
+    while acq.phase != Phase.PROBE:
+        t += 0.033
+        acq.update(t, (0.9, 0.0), 40.0, noise_m=0.001)
+    acq.direction = 1
+    for _ in range(3):
+        t += 0.033
+        acq.update(t, (0.9, 0.0), 40.0, noise_m=0.001)
+    while t < 3.0:
+        t += 0.033
+        acq.update(t, None, None)
+    z = 0.9
+    while acq.phase == Phase.PROBE and t < 6.0:
+        t += 0.033
+        order = acq.update(t, (z, 0.0), 40.0, noise_m=0.001)
+        z += 0.003 if order.left > 0 else 0.0
+    assert not acq.fault and acq.done and acq.facing_away is True
