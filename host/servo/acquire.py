@@ -9,10 +9,10 @@ way the robot faces by what a short probe move does (a pure state machine, one c
     probe    both wheels at probe_duty (raised by probe_step every probe_step_s), forward or
              backward (direction: the way the robot must go if it faces away), until
              the marker has moved probe_m in depth (and three times its noise, the median of
-             the last five sightings against the first five's; after probe_s two): the way
-             it faces follows from the sign of that move; nothing moved by probe_s: the run
-             stops with that reason; moved, but not clearly in depth: on to probe_long_s;
-             the marker unseen for probe_gap_s (the robot stands): the probe begins again
+             the last five sightings against the first five's): the way it faces follows
+             from the sign of that move (at probe_s, from the sign of the move so far);
+             nothing moved by probe_s: the run stops with that reason; the marker unseen for
+             probe_gap_s (the robot stands): the probe's clock stops meanwhile
              (skipped in a re-acquisition that knows the heading: done after the measure)
     a find that fails in a re-acquisition (again: why) says so: "not found again", not
     "never seen"
@@ -44,9 +44,7 @@ class AcquireConfig:
     max_probe_duty: int = 400
     probe_m: float = 0.02
     probe_s: float = 1.5  # a robot that can move has moved by then
-    probe_long_s: float = 2.5  # a move not yet clear in depth is probed on this long
-    probe_max_m: float = 0.08  # or until the sighting has moved this far
-    probe_gap_s: float = 0.3  # the marker unseen this long in the probe: it begins again
+    probe_gap_s: float = 0.3  # the marker unseen this long in the probe: its clock stops
 
 
 @dataclass(frozen=True)
@@ -140,12 +138,13 @@ class Acquisition:
         cfg = self.cfg
         if position is None:
             return Order(0, 0, Phase.PROBE)  # not seen: stand until it is
-        if t - (self._track[-1][0] if self._track else self._t0) > cfg.probe_gap_s:
-            # unseen meanwhile (hidden by something passing), standing: the probe begins
-            # again; timed on, it would find that the marker "did not move" and leave the true
-            # marker out as a look-alike (dev seed 104's trial 61: "never seen")
-            self._track.clear()
-            self._t0 = t
+        gap = t - (self._track[-1][0] if self._track else self._t0)
+        if gap > cfg.probe_gap_s:
+            # unseen meanwhile (hidden by something passing), standing: the probe's clock
+            # stops for the gap; timed on, it would find that the marker "did not move" and
+            # leave the true marker out as a look-alike (dev seed 104's trial 61: "never
+            # seen"). Its driving time, and so its travel, stays within probe_s
+            self._t0 += gap
         self._track.append((t, *position))
         late, moved, dz = t - self._t0 > cfg.probe_s, 0.0, 0.0
         if len(self._track) >= 10:
@@ -158,14 +157,11 @@ class Acquisition:
         if late and moved < cfg.probe_m:  # nothing moved by then: not the robot's marker
             self.fault = NOT_MOVED
             return Order(0, 0, Phase.PROBE)
-        # the heading is the sign of the move in depth, so that move alone decides (a far
-        # sighting's sideways noise says nothing of it): beyond three of a sighting's noise,
-        # or by probe_s beyond two and probe_m; a move not clear in depth by then is probed
-        # on, to probe_long_s or a move of probe_max_m, and then decides (the motion check
-        # corrects a wrong call)
-        long = t - self._t0 > cfg.probe_long_s or moved >= cfg.probe_max_m
-        if len(self._track) >= 10 and (abs(dz) >= max(cfg.probe_m, 3 * noise_m) or late and (
-                abs(dz) >= max(cfg.probe_m, 2 * noise_m) or long)):
+        # the heading is the sign of the move in depth, so that move alone decides early (a
+        # far sighting's sideways noise says nothing of it): beyond three of a sighting's
+        # noise and probe_m; by probe_s the sign of the move in depth decides (the probe's
+        # travel stays within probe_s; the motion check corrects a wrong call)
+        if len(self._track) >= 10 and (abs(dz) >= max(cfg.probe_m, 3 * noise_m) or late):
             self.facing_away = (dz > 0) == (self.direction > 0)
             self._begin(Phase.DONE, t)
             return Order(0, 0, Phase.PROBE)

@@ -27,7 +27,7 @@ class RefindConfig:
     back_s: float = 2.0  # spun back this long without the card square again: whole view
     aspect: float = 0.9  # the card this square to the camera: found
     square: float = 0.97  # the card square to the camera (turns are counted from there)
-    view: float = 0.85  # below this a drive must not turn the card farther (the servo's)
+    view: float = 0.8  # below this a drive must not turn the card farther (the servo's)
     fall: float = 0.08  # or its aspect this far below its best since it came back
     wait_s: float = 0.4  # "lost" this long before the refind begins (a far, small card
     # missing for a few frames comes back by itself)
