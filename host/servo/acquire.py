@@ -8,10 +8,14 @@ way the robot faces by what a short probe move does (a pure state machine, one c
              the marker unseen find_wait_s before they are in: find again
     probe    both wheels at probe_duty (raised by probe_step every probe_step_s), forward or
              backward (direction: the way the robot must go if it faces away), until
-             the marker has moved probe_m (and three times its noise, the median of the last
-             five sightings against the first five's): the way it faces follows,
-             else toward it; nothing moved by probe_s: the run stops with that reason
+             the marker has moved probe_m in depth (and three times its noise, the median of
+             the last five sightings against the first five's): the way it faces follows
+             from the sign of that move (at probe_s, from the sign of the move so far);
+             nothing moved by probe_s: the run stops with that reason; the marker unseen for
+             probe_gap_s (the robot stands): the probe's clock stops meanwhile
              (skipped in a re-acquisition that knows the heading: done after the measure)
+    a find that fails in a re-acquisition (again: why) says so: "not found again", not
+    "never seen"
 """
 
 from __future__ import annotations
@@ -25,6 +29,7 @@ from host.servo.phase import Phase
 
 NEVER_SEEN = "the marker was never seen"
 NOT_MOVED = "the marker did not move when the robot was driven"
+NOT_FOUND_AGAIN = "the marker was not found again"
 
 
 @dataclass(frozen=True)
@@ -39,6 +44,7 @@ class AcquireConfig:
     max_probe_duty: int = 400
     probe_m: float = 0.02
     probe_s: float = 1.5  # a robot that can move has moved by then
+    probe_gap_s: float = 0.3  # the marker unseen this long in the probe: its clock stops
 
 
 @dataclass(frozen=True)
@@ -52,10 +58,12 @@ class Order:
 
 class Acquisition:
     def __init__(self, config: AcquireConfig = AcquireConfig(),
-                 facing_away: bool | None = None) -> None:
+                 facing_away: bool | None = None, again: str = "") -> None:
         """facing_away: the heading already known (a re-acquisition where it cannot have
-        changed): no probe move, done after the measure."""
+        changed): no probe move, done after the measure. again: why the marker is acquired
+        again (a re-acquisition; its find that fails says so, not "never seen")."""
         self.cfg = config
+        self.again = again
         self.phase = Phase.FIND if config.noise_frames > 0 else Phase.DONE
         self.disparities: list[float] = []  # the standing robot's, for its noise
         self.facing_away = facing_away  # learnt by the probe (None: not yet)
@@ -118,7 +126,9 @@ class Acquisition:
         if waited < self.cfg.find_wait_s:
             return Order(0, 0, Phase.WAIT)
         if waited > self.cfg.find_wait_s + self.cfg.find_s:
-            self.fault = NEVER_SEEN
+            self.fault = NEVER_SEEN if not self.again else (
+                f"{NOT_FOUND_AGAIN} in {self.cfg.find_s:g} s of search (acquired again: "
+                f"{self.again})")
             return Order(0, 0, Phase.FIND)
         d = self.cfg.search_duty
         return Order(d, -d, Phase.FIND)
@@ -128,7 +138,15 @@ class Acquisition:
         cfg = self.cfg
         if position is None:
             return Order(0, 0, Phase.PROBE)  # not seen: stand until it is
+        gap = t - (self._track[-1][0] if self._track else self._t0)
+        if gap > cfg.probe_gap_s:
+            # unseen meanwhile (hidden by something passing), standing: the probe's clock
+            # stops for the gap; timed on, it would find that the marker "did not move" and
+            # leave the true marker out as a look-alike (dev seed 104's trial 61: "never
+            # seen"). Its driving time, and so its travel, stays within probe_s
+            self._t0 += gap
         self._track.append((t, *position))
+        late, moved, dz = t - self._t0 > cfg.probe_s, 0.0, 0.0
         if len(self._track) >= 10:
             # the move so far: the median of the last five sightings against the first five's
             # (one wild sighting decides nothing), beyond three of a sighting's noise
@@ -136,15 +154,16 @@ class Acquisition:
             dz = float(np.median([p[1] for p in last]) - np.median([p[1] for p in first]))
             dx = float(np.median([p[2] for p in last]) - np.median([p[2] for p in first]))
             moved = math.hypot(dz, dx)
-            # by probe_s, far away (noisy) a move of probe_m decides: the motion check
-            # corrects a wrong call
-            if moved >= max(cfg.probe_m, 3 * noise_m) or (
-                    t - self._t0 > cfg.probe_s and moved >= cfg.probe_m):
-                self.facing_away = (dz > 0) == (self.direction > 0)
-                self._begin(Phase.DONE, t)
-                return Order(0, 0, Phase.PROBE)
-        if t - self._t0 > cfg.probe_s:
+        if late and moved < cfg.probe_m:  # nothing moved by then: not the robot's marker
             self.fault = NOT_MOVED
+            return Order(0, 0, Phase.PROBE)
+        # the heading is the sign of the move in depth, so that move alone decides early (a
+        # far sighting's sideways noise says nothing of it): beyond three of a sighting's
+        # noise and probe_m; by probe_s the sign of the move in depth decides (the probe's
+        # travel stays within probe_s; the motion check corrects a wrong call)
+        if len(self._track) >= 10 and (abs(dz) >= max(cfg.probe_m, 3 * noise_m) or late):
+            self.facing_away = (dz > 0) == (self.direction > 0)
+            self._begin(Phase.DONE, t)
             return Order(0, 0, Phase.PROBE)
         duty = min(cfg.max_probe_duty,
                    cfg.probe_duty + cfg.probe_step * int((t - self._t0) / cfg.probe_step_s))

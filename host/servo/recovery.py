@@ -14,6 +14,9 @@ a safe stop: the same reason the servo stopped with before it could recover.
     lane       the lane clear for clear_s                20       6
     stale      fresh frames from both sensors            10       6
     outside    the marker admitted again (re-acquired)   10       2
+    lost       the card lost while driving, found again   5       5
+               by a spin back (refind.py), or handed to
+               the acquisition's whole-view search
     target     a nearer object that replaced the target went away, the target found
                again where it was, in both views          -        3
 
@@ -23,7 +26,9 @@ checks a few more, so 10 s is many tries; a board that resets comes back within 
 putting a box down and taking it away again takes a few seconds (the simulated world's boxes
 stay 2-6 s), a box left for 20 s is not coming back soon; a sensor that delivers nothing new
 for 10 s is broken; a marker that keeps leaving the gate after two re-acquisitions is not one
-the servo can trust.
+the servo can trust; the spin back after a card lost while driving takes at most 2 s (3 s
+standing when nothing turned it away), and a robot that loses its card a sixth time in a run
+steers in a way the servo does not follow.
 """
 
 from __future__ import annotations
@@ -31,8 +36,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-MOVED, RESET, LANE, STALE, OUTSIDE, TARGET = "moved", "reset", "lane", "stale", "outside", \
-    "target"
+MOVED, RESET, LANE, STALE, OUTSIDE, TARGET, LOST = "moved", "reset", "lane", "stale", \
+    "outside", "target", "lost"
 WAIT, RESUME, GIVE_UP = "wait", "resume", "give up"
 
 
@@ -50,6 +55,7 @@ BOUNDS: dict[str, Bound] = {
     STALE: Bound(10.0, 0.3, 6),
     OUTSIDE: Bound(10.0, 0.0, 2),
     TARGET: Bound(0.0, 0.0, 3),
+    LOST: Bound(5.0, 0.0, 5),
 }
 
 
