@@ -544,7 +544,9 @@ class Servo:
         the first straight run, after a spin), the controller's facing, within 5 degrees
         for the whole run and 20 for the run until the heading is learnt (min_run_m and the
         run-down); a robot facing the camera before the first probe has told so probes its
-        few cm unchecked. Why the run ends, or ""."""
+        few cm unchecked; a sighting that puts the body inside a fixed object (a disc on a
+        wall) is no robot's, and its probe is not stopped by that object. Why the run ends,
+        or ""."""
         est, c = self.estimator, self.controller
         if est.state is None or c is None or not self.cfg.fixed_check:
             return ""
@@ -569,6 +571,10 @@ class Servo:
         travel = stopping_distance_m(speed)  # its margin_m: the lane steers clear of these
         if cmd.phase == Phase.PROBE:  # it ends once moved probe_m: that and its run-down
             travel = self.cfg.acquire.probe_m + speed * self.cfg.react_s + cfg.block_margin_m
+            inside = cfg.half_width_m - cfg.cell_m / 2
+            if (np.hypot(cells[:, 0] - s.z, cells[:, 1] - s.x) < inside).any():
+                return ""  # a body cannot stand there: a disc on that object, not the robot's
+                # card (the probe finds it out, as it does not move)
         back = cmd.left + cmd.right < 0
         h, runs = self.heading.value, [(travel, self.heading.spread)]
         if h is None:  # the facing assumed; 20 degrees off, until the heading is learnt
