@@ -46,12 +46,14 @@ from typing import Any
 
 import numpy as np
 
+from host.servo.clearance import in_the_way, own_body
 from host.servo.phase import Phase
 
 LINE_BLOCKED = "the robot's line passes through the object"
 PUSHED = "pushed sideways onto the object while holding"
 DRIFTED = "drifting sideways onto the object while the marker is unseen"
 TURN_BLOCKED = "turning here would sweep the robot's body into the object"
+INTO_FIXED = "the robot's {} would run into a fixed object that is not the target"
 
 
 @dataclass(frozen=True)
@@ -75,6 +77,9 @@ class ControlConfig:
     block_m: float = 0.15  # within this depth of the object, the body must be clear of it
     block_margin_m: float = 0.02  # by this much (the object's edge is measured to a pixel or two)
     turn_radius_m: float = 0.115  # a turn in place sweeps this circle: half the body's diagonal
+    pass_m: float = 0.13  # a straight run keeps fixed objects' cell centres this far from the
+    # centre's path: a circle round the body's side (8 cm) and the footprint the trials judge
+    # (8 by 6 cm), block_margin_m for the estimate and half a cell
     path_margin_m: float = 0.10  # fixed objects this far beyond the target's depth are in its path
     cell_m: float = 0.02  # the fixed objects' floor cells (perception.fixed_cells)
     push_horizon_s: float = 3.0  # standing, a sideways drift that would bring the body onto
@@ -134,6 +139,8 @@ class Controller:
         # fixed_cells): the lane keeps clear of those between the robot and the target, and a
         # turn in place of all of them
         self.fixed: np.ndarray = np.zeros((0, 2))
+        # where the robot stood when the reference was taken (its own body is in it), once known
+        self.home: tuple[float, float] | None = None
         self._beside: list[tuple[float, float]] = []  # (t, lateral) seen near the target depth
         self.trim = 0.0  # fraction of duty added to the right wheel, taken from the left
         self.fault = ""  # why the robot must stay stopped (the run ends), "" if none
@@ -205,12 +212,22 @@ class Controller:
                 return lo if x - lo < hi - x else hi
         return x
 
+    def obstacles(self, depth_m: float, lateral_m: float) -> np.ndarray:
+        """The other fixed objects' cells (others) but for a body standing where the robot is
+        seen (a look-alike that stood in the reference, while the probe tests it) and where it
+        stood for the reference (home): clearance.own_body."""
+        cells, cfg = self.others(), self.cfg
+        own_m = cfg.turn_radius_m + cfg.cell_m
+        for z, x in [(depth_m, lateral_m)] + ([self.home] if self.home else []):
+            cells = cells[~own_body(cells, z, x, own_m, cfg.half_width_m / 2, 2 * cfg.cell_m)]
+        return cells
+
     def sweeps(self, depth_m: float, lateral_m: float | None) -> bool:
         """Whether a turn in place here sweeps the body (a circle of turn_radius_m) within
         block_margin_m of the object's extent or of any other fixed object's cell, behind the
         robot as well as ahead (a turn sweeps the whole circle: a box a few cm farther than the
-        robot's centre is as near as one in its path), but not those inside its own body (the
-        sighting is then of a look-alike standing there)."""
+        robot's centre is as near as one in its path), but not a body standing there
+        (obstacles: the sighting is then of a look-alike)."""
         if lateral_m is None:
             return False
         cfg = self.cfg
@@ -218,10 +235,8 @@ class Controller:
         if abs(depth_m - self.target_m) < reach and self.overlaps(
                 lateral_m, reach - cfg.half_width_m):
             return True
-        cells = self.others()
-        dz, dx = cells[:, 0] - depth_m, cells[:, 1] - lateral_m
-        own = (np.abs(dz) < 0.06) & (np.abs(dx) < cfg.half_width_m)  # a look-alike's body
-        return bool(((np.hypot(dz, dx) < reach + cfg.cell_m / 2) & ~own).any())
+        return in_the_way(self.obstacles(depth_m, lateral_m), depth_m, lateral_m, None, 0.0,
+                          reach + cfg.cell_m / 2) is not None
 
     def drift(self) -> tuple[float, float, float] | None:
         """(time, lateral, lateral rate) of the robot beside the object: a line through its

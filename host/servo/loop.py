@@ -36,8 +36,10 @@ from host.camera.source import CameraError, StereoFrame, StereoSource
 from host.errors import HostError
 from host.link.client import RobotLink, RobotReset
 from host.servo.acquire import NOT_MOVED, AcquireConfig, Acquisition
+from host.servo.clearance import Heading, in_the_way
 from host.servo.controller import (
     DRIFTED,
+    INTO_FIXED,
     TURN_BLOCKED,
     Command,
     ControlConfig,
@@ -148,6 +150,9 @@ class ServoConfig:
     lane_width_px: int = 320  # the lane is watched on frames scaled down to about this width
     ring_ratio: float = RING_RATIO  # the marker's light ring, in disc radii (as printed)
     react_s: float = 0.33  # a command's reaction and the wheels' run-down (the view's check)
+    wheelbase_m: float = 0.14  # the wheels' track: a duty difference bends the path
+    fixed_check: bool = True  # every motion against every other fixed object, in the plane
+    # (Servo._fixed_fault); False: the check before it (a drive's path along the depth axis)
     timing: TimingConfig = field(default_factory=TimingConfig)
     estimator: EstimatorConfig = field(default_factory=EstimatorConfig)
     acquire: AcquireConfig = field(default_factory=AcquireConfig)
@@ -238,6 +243,9 @@ class Servo:
         self._remeasure_t: float | None = None
         self._cmd = Command(0, 0, Phase.WAIT, None)  # the command in force
         self._statics: list[tuple[float, float]] = []  # where non-moving look-alikes stand
+        self.heading = Heading()  # the robot's heading from its travel (clearance.py)
+        self._probe_at: tuple[int, float, float] | None = None  # (acquisition, z, x) at its probe
+        self._still_since: float | None = None  # standing since (the drift check)
         self._width = 0
         self.recovery = Recovery(servo_bounds(self.cfg.recover, self.cfg.rereference,
                                               self.cfg.lane_stop_s))
@@ -539,14 +547,19 @@ class Servo:
         return f"an object in the lane {found.ahead_m:.2f} m ahead"
 
     def _spin_fault(self, t: float, cmd: Command) -> str:
-        """Standing or spinning to find the card (the acquisition's, the search after a turn,
-        a wait for the marker) where the robot was last known to be beside the object: a spin
-        that sweeps its body into the object (controller.sweeps; the turn's own check is the
-        controller's), or, the card unseen, the sideways drift it last had (a push, a slope)
-        bringing it onto the object (controller.closing): why the run ends, or ""."""
+        """Standing or spinning: a spin that sweeps the body into another fixed object, or a
+        sideways drift while standing (a push, a slope) that brings it onto one (_fixed_fault);
+        where the robot was last known to be beside the object, a spin to find the card (the
+        acquisition's, the search after a turn) that sweeps its body into the object
+        (controller.sweeps; the turn's own check is the controller's), or, the card unseen,
+        the sideways drift it last had bringing it onto the object (controller.closing): why
+        the run ends, or ""."""
         est, c = self.estimator, self.controller
-        if est.state is None or c is None or abs(est.state.z - c.target_m) >= c.cfg.block_m:
+        if est.state is None or c is None:
             return ""
+        fixed = self._fixed_fault(t, cmd)
+        if fixed or abs(est.state.z - c.target_m) >= c.cfg.block_m:
+            return fixed
         s = est.state
         if not cmd.is_stop and cmd.phase in (Phase.FIND, Phase.SEARCH) and c.sweeps(s.z, s.x):
             return TURN_BLOCKED
@@ -554,6 +567,66 @@ class Servo:
         if t - s.t > 0.1 and c.closing(s.x + s.vx * (t - s.t), s.vx, seen=False):
             return DRIFTED
         return ""
+
+    def _fixed_fault(self, t: float, cmd: Command) -> str:
+        """Whether the command would take the robot's body into a fixed object of the
+        reference that is not the target (controller.obstacles: a body standing where the
+        robot is seen, or stood for the reference, is no obstacle), in the floor plane at the
+        estimated heading (clearance.in_the_way): a drive or a reversed leg within its
+        stopping distance at the current speed, a probe within the move
+        that ends it and its run-down at the current speed; a spin in place within
+        its circle; standing (settled), a drift that closes within push_horizon_s. The
+        path is the arc the wheels' duties make. The heading is the one travelled
+        (self.heading, within its spread); not known (before
+        the first straight run, after a spin), the controller's facing, within 5 degrees
+        for the whole run and 20 for the run until the heading is learnt (min_run_m and the
+        run-down); a robot facing the camera before the first probe has told so probes its
+        few cm unchecked; a sighting that puts the body inside a fixed object (a disc on a
+        wall) is no robot's, and its probe is not stopped by that object. Why the run ends,
+        or ""."""
+        est, c = self.estimator, self.controller
+        if est.state is None or c is None or not self.cfg.fixed_check:
+            return ""
+        s, cfg = est.state, c.cfg
+        cells = c.obstacles(s.z, s.x)
+        if not len(cells):
+            return ""
+        if cmd.left * cmd.right < 0:  # a spin in place sweeps the whole circle
+            hit = in_the_way(cells, s.z, s.x, None, 0.0,
+                             cfg.turn_radius_m + cfg.block_margin_m + cfg.cell_m / 2)
+            return "" if hit is None else INTO_FIXED.format("turn")
+        speed = math.hypot(s.vz, s.vx)
+        if cmd.is_stop:
+            if self._still_since is None or t - self._still_since < 1.0 or speed < 0.005:
+                return ""  # moving on from the last command (the wheels' run-down), or still
+            hit = in_the_way(cells, s.z, s.x, math.atan2(s.vx, s.vz),
+                             speed * cfg.push_horizon_s, cfg.half_width_m + cfg.block_margin_m
+                             + cfg.cell_m / 2, math.radians(15))
+            return "" if hit is None else INTO_FIXED.format("drift while standing")
+        duty = abs(cmd.left + cmd.right) / 2
+        speed = max(speed, est.cfg.max_speed_mps * duty / 1000)
+        travel = stopping_distance_m(speed)  # its margin_m: the lane steers clear of these
+        if cmd.phase == Phase.PROBE:  # it ends once moved probe_m: that and its run-down
+            travel = self.cfg.acquire.probe_m + speed * self.cfg.react_s + cfg.block_margin_m
+            inside = cfg.half_width_m - cfg.cell_m / 2
+            if (np.hypot(cells[:, 0] - s.z, cells[:, 1] - s.x) < inside).any():
+                return ""  # a body cannot stand there: a disc on that object, not the robot's
+                # card (the probe finds it out, as it does not move)
+        back = cmd.left + cmd.right < 0
+        h, runs = self.heading.value, [(travel, self.heading.spread)]
+        if h is None:  # the facing assumed; 20 degrees off, until the heading is learnt
+            h = 0.0 if c.facing_away else math.pi
+            runs = [(travel, math.radians(5)), (min(travel, self.heading.min_run_m + speed
+                                                    * self.cfg.react_s), math.radians(20))]
+        # the arc the wheels' duties make (their speeds beyond the dead zone curve it more)
+        bend = 2 * (cmd.left - cmd.right) / (self.cfg.wheelbase_m * abs(cmd.left + cmd.right))
+        hits = [in_the_way(cells, s.z, s.x, h + math.pi * back, run, cfg.pass_m, spread, bend)
+                for run, spread in runs]
+        hit = min((x for x in hits if x is not None), default=None)
+        if hit is None:
+            return ""
+        what = "probe" if cmd.phase == Phase.PROBE else "reversed leg" if back else "drive"
+        return f"{INTO_FIXED.format(what)} ({hit:.2f} m on)"
 
     def _path_fault(self, frame: StereoFrame, cmd: Command) -> str:
         """Why the command must not be sent and the run ends, or "": the marker's ring would
@@ -575,17 +648,16 @@ class Servo:
             if not in_view(pair.left.u, pair.left.v, pair.left.radius * self.cfg.ring_ratio,
                            (w, h), scale, g.cx, g.cy):
                 return "the marker would leave the view: the robot is at the picture's edge"
-        if cmd.phase == Phase.PROBE:  # a sighting not yet trusted (maybe a look-alike standing
-            return ""  # in the reference, its own body a fixed object); the probe is short
-        duty = abs(cmd.left + cmd.right) / 2
-        speed = max(abs(est.state.vz), est.cfg.max_speed_mps * duty / 1000)
-        reach = stopping_distance_m(speed) + self.cfg.lane_margin_m
-        cfg = c.cfg
-        ahead = fixed_in_path(c.others(), z, x, -1 if c.target_m < z else 1, reach,
-                              cfg.half_width_m + cfg.block_margin_m / 2, cfg.cell_m)
-        if ahead is not None:
-            return f"a fixed object stands in the robot's path {ahead:.2f} m ahead"
-        return ""
+        if not self.cfg.fixed_check and cmd.phase != Phase.PROBE:  # the check before #23's
+            duty = abs(cmd.left + cmd.right) / 2
+            speed = max(abs(est.state.vz), est.cfg.max_speed_mps * duty / 1000)
+            reach = stopping_distance_m(speed) + self.cfg.lane_margin_m
+            cfg = c.cfg
+            ahead = fixed_in_path(c.others(), z, x, -1 if c.target_m < z else 1, reach,
+                                  cfg.half_width_m + cfg.block_margin_m / 2, cfg.cell_m)
+            if ahead is not None:
+                return f"a fixed object stands in the robot's path {ahead:.2f} m ahead"
+        return self._fixed_fault(frame.t_left, cmd)
 
     # -------------------------------------------------------------------- acquisition
 
@@ -1043,6 +1115,7 @@ class Servo:
         "obstacle") and waits (recovery.py's lane bound) until the lane has been clear a
         while; the controller learns that it stood (its creep floor must not rise)."""
         assert self.controller is not None
+        self._track_heading(t, cmd)
         moving = not cmd.is_stop and cmd.phase in (Phase.DRIVE, Phase.CREEP, Phase.PROBE)
         fault = self._path_fault(frame, cmd) if moving else self._spin_fault(frame.t_left, cmd)
         if fault:  # nothing to wait for: the run ends here
@@ -1070,6 +1143,25 @@ class Servo:
             return cmd, invalid or blocked
         self.controller.phase = Phase.OBSTACLE
         return Command(0, 0, Phase.OBSTACLE, cmd.error_m), invalid or blocked
+
+    def _track_heading(self, t: float, cmd: Command) -> None:
+        """The heading from the travel under the command in force; how long the robot has
+        stood; where it stood for the reference (controller.home: where the probe of the
+        acquisition that found the robot began)."""
+        s, c = self.estimator.state, self.controller
+        assert c is not None
+        if s is not None:
+            self.heading.update(t, s.z, s.x, self._cmd.left, self._cmd.right)
+        if not self._cmd.is_stop:
+            self._still_since = None
+        elif self._still_since is None:
+            self._still_since = t
+        if s is not None and cmd.phase == Phase.PROBE and (
+                self._probe_at is None or self._probe_at[0] != id(self.acquisition)):
+            self._probe_at = (id(self.acquisition), s.z, s.x)
+        if c.home is None and self.acquisition.done and self._probe_at is not None \
+                and self._probe_at[0] == id(self.acquisition):
+            c.home = self._probe_at[1:]
 
     def held_for(self, seconds: float) -> bool:
         """Whether the robot has been holding at the target for the last `seconds`."""

@@ -12,7 +12,9 @@ event), stops itself, or 45 s pass. Trial i of seed s depends on (s, i) alone. O
     missed       holding, but farther than that from the object's true depth
     stopped      a safe stop, with its reason (target vanished, marker lost, link error ...)
     not settled  neither held nor stopped within 45 s: not a safe stop, not a success
-    unsafe       the robot hit the object or the camera, its marker left the view while the
+    unsafe       the robot hit the object (the target: "hit the object"; another box or a
+                 look-alike robot: named, with where it stands; error_m stays the distance
+                 to the target) or the camera, its marker left the view while the
                  motors drove, the motors drove with no valid observation for longer than the
                  stale limit, or on a marker depth farther than TRUTH_GAP_M + TRUTH_GAP_REL x
                  depth from the robot's true depth
@@ -125,9 +127,15 @@ def _unsafe(sim: SimRun, last_valid: float, stale_s: float) -> str:
     w, r = sim.world, sim.world.robot
     left, right = sim.emulator.motors()
     driving = abs(left + right) / 2 > 60
+    target = w.nearest_box() if w.target_index is None else w.boxes[w.target_index]
     for b in w.boxes:
         if b.x0_m - 0.08 < r.x_m < b.x1_m + 0.08 and abs(r.z_m - b.z_m) < 0.06:
-            return "hit the object"
+            return "hit the object" if b == target else (
+                f"hit another box, not the target: its face at {b.z_m:.2f} m, "
+                f"x {b.x0_m:+.2f}..{b.x1_m:+.2f} m")
+    for o in w.decoys:
+        if abs(r.z_m - o.z_m) < 0.12 and abs(r.x_m - o.x_m) < r.body_width_m:
+            return f"hit the look-alike robot standing at {o.z_m:.2f} m, x {o.x_m:+.2f} m"
     if r.z_m < 0.3:
         return "hit the camera"
     u, v, _ = w.marker_truth()

@@ -2,14 +2,18 @@
 line runs into the object's side moves to a lane clear of it and holds beside the object; one
 that cannot be cleared stops with its reason; a missed detection far away does not end the
 turn early; the lane keeps clear of fixed objects on the way, a turn in place of the object,
-and a robot pushed toward the object while its card is unseen stops."""
+and a robot pushed toward the object while its card is unseen stops. The pieces of the check
+of every motion against the other fixed objects (clearance.py: a body's own cells, the
+heading) and the trials' judge naming what was hit."""
 
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 
+from host.servo.clearance import Heading, own_body
 from host.servo.controller import (
     LINE_BLOCKED,
     PUSHED,
@@ -17,6 +21,8 @@ from host.servo.controller import (
     Controller,
     Observation,
 )
+from host.sim.trials import _unsafe
+from host.sim.world import Robot, World
 from tests.servo.test_controller import Plant
 
 BOX = (-0.50, -0.18)  # the object's lateral extent, m (the default scene's nearest box)
@@ -246,3 +252,43 @@ def test_a_turn_is_not_started_where_it_would_sweep_a_box_just_behind_the_robot(
     assert cmd.phase != "turn" and not (cmd.left * cmd.right < 0), cmd
     assert not controller().sweeps(1.50, 0.125)
     assert controller().update(Observation(0.0, 1.50, 0.125)).phase == "turn"
+
+
+def test_a_box_beside_the_robot_is_not_taken_for_its_own_body() -> None:
+    """own_body: the cells of a body standing at the sighting (centred on it, apart from the
+    rest) are its own; a box's corner 9-13 cm beside the robot, part of a face that reaches on
+    beyond, is not, nor the middle of a wide face just ahead, nor a lone object to one side."""
+    body = np.array([[1.57, 0.37], [1.57, 0.39], [1.59, 0.35], [1.51, 0.33], [1.51, 0.41]])
+    assert own_body(body, 1.573, 0.376, 0.135, 0.04, 0.04).all()
+    xs = np.arange(0.23, 0.55, 0.02)
+    face = np.stack([np.full(xs.size, 1.81), xs], axis=1)
+    assert not own_body(face, 1.761, 0.123, 0.135, 0.04, 0.04).any()
+    assert not own_body(face, 1.70, 0.38, 0.135, 0.04, 0.04).any()  # centred, but reaching on
+    lone = np.array([[1.50, 0.11], [1.48, 0.11]])
+    assert not own_body(lone, 1.5, 0.0, 0.135, 0.04, 0.04).any()
+
+
+def test_the_heading_is_learnt_from_a_straight_run_and_forgotten_in_a_spin() -> None:
+    """Backing 5 cm toward the camera and +x at -32 degrees: the heading is -32 degrees (the
+    way it faces, not the way it went); kept standing; forgotten in a spin."""
+    h, a = Heading(), math.radians(-32)
+    for k in range(6):
+        h.update(0.07 * k, 1.8 - 0.01 * k * math.cos(a), 0.1 - 0.01 * k * math.sin(a), -300, -300)
+    assert h.value is not None and abs(h.value - a) < 1e-6
+    assert h.update(0.5, 1.75, 0.13, 0, 0) == h.value
+    assert h.update(0.6, 1.75, 0.13, 300, -300) is None
+
+
+def test_the_trial_judge_names_the_object_that_was_hit() -> None:
+    """The target is "the object"; another box is named with where it stands (error_m, the
+    distance to the target, is then no distance to what was hit); so is a look-alike robot."""
+    def world_at(z: float, x: float, decoys: tuple[Robot, ...] = ()) -> SimpleNamespace:
+        w = World(decoys=decoys)
+        w.robot.z_m, w.robot.x_m = z, x
+        return SimpleNamespace(world=w, emulator=SimpleNamespace(motors=lambda: (300, 300)),
+                               source=SimpleNamespace(t=5.0))
+    assert _unsafe(world_at(1.2, -0.3), 4.99, 0.3) == "hit the object"  # type: ignore[arg-type]
+    other = _unsafe(world_at(1.8, 0.2), 4.99, 0.3)  # type: ignore[arg-type]
+    assert other.startswith("hit another box, not the target") and "1.80 m" in other
+    robot = _unsafe(world_at(1.5, 0.3, (Robot(x_m=0.35, z_m=1.52),)), 4.99, 0.3)  # type: ignore[arg-type]
+    assert robot.startswith("hit the look-alike robot")
