@@ -82,8 +82,10 @@ def simulation(setup: Setup = Setup(), reference: bool = True) -> Iterator[SimRu
     # the native core: bytes at line rate on the simulated clock; or a board running the AVR
     # binary in real time on a pty (its advance() waits on the wall clock)
     emulator: Any = Emulator(faults.link) if setup.board is None else setup.board
+    # a servo matching in grey gets grey images from the camera (SimSource's grey)
     source = SimSource(world, emulator, setup.fps, renderer=renderer, events=faults.events,
-                       latency_ms=faults.motor.latency_ms, seed=setup.seed)
+                       latency_ms=faults.motor.latency_ms, seed=setup.seed,
+                       grey=not setup.params.colour)
     port: Any = setup.board.path if setup.board else LockstepLine(emulator, source.run_ms,
                                                                    lambda: source.now_ms)
     reply_timeout_s = max(0.2, setup.reply_timeout_s) if setup.board else setup.reply_timeout_s
