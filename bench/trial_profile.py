@@ -10,11 +10,10 @@ cache) so that neither is counted.
 PYTHONPATH pointing at another checkout it times that code with the same script, which is how
 a before/after ratio is taken (run them alternately: the machine is shared). With --plain,
 --colour-camera runs each trial a second time, right after, with the simulated camera sending
-its colour images as a real Minoru does (the trials' camera sends them in grey, since the servo
-matches in grey: host.sim.run), and prints the two CPU times side by side and their ratio.
-Dev seeds only
-(1..8, 100..199; never 9 or 10..99, the lead's reported campaigns). Prints the load average
-with the figures."""
+its colour images as a real Minoru does (the trials' camera renders them in grey, since the
+servo matches in grey: host.sim.run, Renderer's grey), and prints the two CPU times side by
+side and their ratio. Dev seeds only (1..8, 100..199; never 9 or 10..99, the lead's reported
+campaigns). Prints the load average with the figures."""
 
 from __future__ import annotations
 
@@ -114,7 +113,7 @@ def main() -> None:
               f"{t.outcome} {t.reason} [{t.faults}]")
         if a.colour_camera:
             t2 = time.process_time()
-            with _colour_camera(source):
+            with _colour_camera(renderer):
                 c = run_trial((a.seed, i, size, params, False))
             colour_cpu += time.process_time() - t2
             print(f"   colour camera: {time.process_time() - t2:.2f} s CPU, {c.sim_s:.1f} s "
@@ -135,19 +134,18 @@ def main() -> None:
 
 
 @contextlib.contextmanager
-def _colour_camera(source: Any) -> Iterator[None]:
-    """The simulated camera sends its colour images (SimSource's grey off) meanwhile."""
-    init = source.SimSource.__init__
+def _colour_camera(renderer: Any) -> Iterator[None]:
+    """The simulated camera sends its colour images (the Renderer's grey off) meanwhile."""
+    init = renderer.Renderer.__init__
 
     def colour(self: Any, *args: Any, **kw: Any) -> None:
-        init(self, *args, **kw)
-        self.grey = False
+        init(self, *args, **(kw | {"grey": False}))
 
-    source.SimSource.__init__ = colour
+    renderer.Renderer.__init__ = colour
     try:
         yield
     finally:
-        source.SimSource.__init__ = init
+        renderer.Renderer.__init__ = init
 
 
 def _untimed(owner: object, name: str, label: str) -> None:

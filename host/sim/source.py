@@ -6,7 +6,6 @@ from __future__ import annotations
 import math
 from collections import deque
 
-import cv2
 import numpy as np
 
 from host.camera.source import StereoFrame, StereoSource
@@ -35,23 +34,16 @@ class SimSource(StereoSource):
     Captures keep the camera's own schedule: time the host spends waiting on the link (which
     runs the same clock, host.emulator.lockstep) does not shift it, and a capture the host was
     too busy to take is overwritten by the next. The scene's events (host.sim.faults.Event)
-    happen at their times; what each did is in log. grey: a colour camera's images leave it
-    in grey (OpenCV's BGR2GRAY of the colour image), for a servo that matches in grey and
-    would convert each view itself (several times a frame, after rectifying three channels):
-    the trials' configuration (host.sim.run). A run that matches in colour (`host servo --sim`
-    by default) gets the colour images, rectified and converted by the host as from a real
-    Minoru."""
+    happen at their times; what each did is in log."""
 
     def __init__(self, world: World, board: Board, fps: float = 30.0,
                  reference_frames: int = 5, renderer: Renderer | None = None,
-                 events: tuple[Event, ...] = (), latency_ms: float = 0.0, seed: int = 0,
-                 grey: bool = False) -> None:
+                 events: tuple[Event, ...] = (), latency_ms: float = 0.0, seed: int = 0) -> None:
         self.world, self.board, self.fps = world, board, fps
         self.renderer = renderer or Renderer(world, seed=world.seed)
         self.reference_frames = reference_frames
         self.events = sorted(events, key=lambda e: e.t_s)
         self.latency_ms = latency_ms
-        self.grey = grey  # a colour sensor's images leave the camera in grey (see _capture)
         self.rng = np.random.default_rng(seed + 104729)
         self.index = 0
         self.now_ms = 0
@@ -250,7 +242,5 @@ class SimSource(StereoSource):
         blur = (vel[0] * self.renderer.camera.exposure_ms / 1000,
                 vel[1] * self.renderer.camera.exposure_ms / 1000)
         image, _ = self.renderer.view(side, with_robot, blur, t_s=began)
-        if self.grey and image.ndim == 3:
-            image = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
         self._held[side] = (image, stamp)
         return image, stamp
