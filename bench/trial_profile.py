@@ -8,17 +8,22 @@ cache) so that neither is counted.
 
 --plain times each trial whole, without the wrappers (which cost some CPU of their own); with
 PYTHONPATH pointing at another checkout it times that code with the same script, which is how
-a before/after ratio is taken (run them alternately: the machine is shared). Dev seeds only
-(1..8, 100..199; never 9 or 10..99, the lead's reported campaigns). Prints the load average
-with the figures."""
+a before/after ratio is taken (run them alternately: the machine is shared). With --plain,
+--colour-camera runs each trial a second time, right after, with the simulated camera sending
+its colour images as a real Minoru does (the trials' camera renders them in grey, since the
+servo matches in grey: host.sim.run, Renderer's grey), and prints the two CPU times side by
+side and their ratio. Dev seeds only (1..8, 100..199; never 9 or 10..99, the lead's reported
+campaigns). Prints the load average with the figures."""
 
 from __future__ import annotations
 
 import argparse
 import collections
+import contextlib
 import os
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from typing import Any
 
 from host.sim.trial_backends import one_thread
 
@@ -32,7 +37,12 @@ def main() -> None:
     ap.add_argument("--trials", type=int, nargs="+", default=[0, 1, 2, 3, 4, 5])
     ap.add_argument("--plain", action="store_true",
                     help="time whole trials only (no wrappers inside)")
+    ap.add_argument("--colour-camera", action="store_true",
+                    help="each trial again with the camera sending colour images (the "
+                         "reference for the grey camera's ratio)")
     a = ap.parse_args()
+    if a.colour_camera and not a.plain:
+        ap.error("--colour-camera goes with --plain (whole trials timed, alternating)")
     if a.seed not in DEV_SEEDS:
         ap.error("dev seeds only: 1..8 and 100..199 (9 and 10..99 are held out for reported "
                  "figures)")
@@ -93,13 +103,25 @@ def main() -> None:
     load = os.getloadavg()[0]
     t0 = time.process_time()
     sim = 0.0
+    colour_cpu = 0.0
     for i in a.trials:
         t1 = time.process_time()
         t = run_trial((a.seed, i, size, params, False))
+        cpu = time.process_time() - t1
         sim += t.sim_s
-        print(f"trial {i}: {time.process_time() - t1:.2f} s CPU, {t.sim_s:.1f} s simulated, "
+        print(f"trial {i}: {cpu:.2f} s CPU, {t.sim_s:.1f} s simulated, "
               f"{t.outcome} {t.reason} [{t.faults}]")
-    total = time.process_time() - t0
+        if a.colour_camera:
+            t2 = time.process_time()
+            with _colour_camera(renderer):
+                c = run_trial((a.seed, i, size, params, False))
+            colour_cpu += time.process_time() - t2
+            print(f"   colour camera: {time.process_time() - t2:.2f} s CPU, {c.sim_s:.1f} s "
+                  f"simulated, {c.outcome} {c.reason}")
+    total = time.process_time() - t0 - colour_cpu
+    if a.colour_camera:
+        print(f"grey camera {total:.2f} s CPU, colour camera {colour_cpu:.2f} s: "
+              f"{total / colour_cpu:.2f}x (alternating in this process)")
     steps = calls["servo step (the rest)"]
     frames = f"; {steps} frames processed, {1e3 * total / max(1, steps):.2f} ms a frame" \
         if steps else ""
@@ -109,6 +131,21 @@ def main() -> None:
         print(f"  {label:24s} {v:6.2f} s {100 * v / total:5.1f} %  {calls[label]:7d} calls "
               f"{1e3 * v / max(1, calls[label]):7.3f} ms each")
     print(f"  {'other':24s} {total - sum(spent.values()):6.2f} s")
+
+
+@contextlib.contextmanager
+def _colour_camera(renderer: Any) -> Iterator[None]:
+    """The simulated camera sends its colour images (the Renderer's grey off) meanwhile."""
+    init = renderer.Renderer.__init__
+
+    def colour(self: Any, *args: Any, **kw: Any) -> None:
+        init(self, *args, **(kw | {"grey": False}))
+
+    renderer.Renderer.__init__ = colour
+    try:
+        yield
+    finally:
+        renderer.Renderer.__init__ = init
 
 
 def _untimed(owner: object, name: str, label: str) -> None:

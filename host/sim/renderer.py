@@ -8,7 +8,9 @@ anti-aliased marker at its exact sub-pixel position. A rig knocked since its cal
 (pitch_deg) sees the ideal view through the rotation's homography; mains flicker (flicker)
 modulates each row by the light at the time a rolling shutter reads it. Lens distortion maps
 each raw pixel to where the ideal (rectified) camera saw it, so a calibration on rendered
-chessboards recovers it as it would a real lens.
+chessboards recovers it as it would a real lens. A colour camera renders grey images for a
+servo that matches in grey (grey=True: the trials), the white balance's gains weighted as the
+host's grey conversion weighs them.
 
 Speed: a sensor's grey level is a function of the ideal view's at that pixel alone, so with no
 pitch, flicker or lens the bare scene's sensor image is made once per layout and noise field,
@@ -33,6 +35,7 @@ from host.stereo.synthetic import Layer, random_texture, render_view
 
 MARKER_DARK = 25.0
 MARKER_LIGHT = 235.0
+GREY_WEIGHTS = np.array([0.114, 0.587, 0.299])  # B, G, R: cv2.COLOR_BGR2GRAY's
 NEARER_PX = 0.25  # a drawn surface shows where the scene is not nearer than it by this much
 
 
@@ -129,9 +132,17 @@ def _lens_hit_box(bounds: LensBounds, mx: np.ndarray, my: np.ndarray,
 
 
 class Renderer:
-    def __init__(self, world: World, camera: CameraFaults = CameraFaults(), seed: int = 0
-                 ) -> None:
-        self.world, self.camera = world, camera
+    def __init__(self, world: World, camera: CameraFaults = CameraFaults(), seed: int = 0,
+                 grey: bool = False) -> None:
+        """grey: a colour camera (white balance) sends grey images: each pixel's BGR levels
+        before rounding weighted as OpenCV's BGR2GRAY weighs them (0.114, 0.587, 0.299), then
+        rounded once: within a grey level of the grey of its colour image where no channel
+        saturates, with one plane's work instead of three."""
+        self.world, self.camera, self.grey = world, camera, grey
+        # each sensor's white balance: its BGR gains, or the one gain of the grey image
+        self._white: list[tuple[float, ...]] = [
+            (float(GREY_WEIGHTS @ np.asarray(w, np.float64)),) if grey else w
+            for w in camera.white]
         self.rng = np.random.default_rng(seed)
         self.seed = seed
         self._static_key: tuple[object, ...] | None = None
@@ -410,10 +421,11 @@ class Renderer:
             np.maximum(img, 0.0, out=img)  # then |x w| is x w, and what was below 0 is 0 still
             if not cam.white:
                 return cv2.convertScaleAbs(img)
-            return cv2.merge([cv2.convertScaleAbs(img, alpha=float(np.float32(c)))
-                              for c in cam.white[side]])
+            planes = [cv2.convertScaleAbs(img, alpha=float(np.float32(c)))
+                      for c in self._white[side]]
+            return planes[0] if self.grey else cv2.merge(planes)
         if cam.white:
-            img = img[..., None] * np.asarray(cam.white[side], np.float32)
+            img = self._balanced(img, side)
         if lens is not None:
             img = cv2.remap(img.astype(np.float32, copy=False), lens[0], lens[1],
                             cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
@@ -435,8 +447,13 @@ class Renderer:
             noise = self._noise[k]
             img += noise if region is None else noise[region[0]:region[1], region[2]:region[3]]
         if cam.white:
-            img = img[..., None] * np.asarray(cam.white[side], np.float32)
+            img = self._balanced(img, side)
         return img.astype(np.float32, copy=False)
+
+    def _balanced(self, img: np.ndarray, side: int) -> np.ndarray:
+        """The white balance's gains applied: a plane each (BGR), or the one grey plane."""
+        gains = np.asarray(self._white[side], np.float32)
+        return img * gains[0] if self.grey else img[..., None] * gains
 
     def _through_lens(self, img: np.ndarray, side: int, k: int | None) -> np.ndarray:
         """_sensor(img) with a lens (no pitch, flicker), from the bare scene's image: remap()

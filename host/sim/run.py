@@ -78,7 +78,9 @@ def simulation(setup: Setup = Setup(), reference: bool = True) -> Iterator[SimRu
     world = World.for_size(*setup.size, seed=setup.seed, motor_faults=faults.motor, **kw)
     r = world.robot
     r.z_m, r.x_m, r.theta = setup.start_z_m, setup.start_x_m, setup.start_theta
-    renderer = Renderer(world, faults.camera, seed=setup.seed)
+    # a servo that matches in grey (the trials) gets grey images from the colour camera: it
+    # would turn each view grey itself, several times a frame, after rectifying three channels
+    renderer = Renderer(world, faults.camera, seed=setup.seed, grey=not setup.params.colour)
     # the native core: bytes at line rate on the simulated clock; or a board running the AVR
     # binary in real time on a pty (its advance() waits on the wall clock)
     emulator: Any = Emulator(faults.link) if setup.board is None else setup.board
