@@ -1,12 +1,20 @@
 """Safety: a hidden marker stops the robot within one frame; a robot that stops answering is
-reported and its own link-loss stop holds it."""
+reported and its own link-loss stop holds it; the trials' judge calls a box the scene puts down
+touching the robot a hit only when the robot then closes on it."""
 
 from __future__ import annotations
+
+import math
+from types import SimpleNamespace
 
 import pytest
 
 from host.emulator.emulator import Faults
 from host.link.client import LinkError
+from host.servo.loop import LogRow
+from host.servo.phase import Phase
+from host.sim.trials import Judge
+from host.sim.world import Box, Robot, World
 
 from .simulation import simulation
 
@@ -44,3 +52,36 @@ def test_a_silent_robot_is_reported_and_its_link_loss_stop_holds() -> None:
         for _ in range(1000):
             sim.source.run_ms(1)
         assert abs(sim.world.robot.z_m - z) < 0.001  # and the robot stays where it stopped
+
+
+def _judged_world() -> tuple[Judge, World, LogRow]:
+    """The trials' judge over a world whose robot stands 1.76 m from the camera, its body's
+    edge across the line of the target box's near edge (x -0.5..-0.18 m, at 1.48 m)."""
+    world = World(boxes=(Box(1.48, -0.50, -0.18, 0.38),), robot=Robot(x_m=-0.127, z_m=1.763))
+    sim = SimpleNamespace(world=world, emulator=SimpleNamespace(motors=lambda: (0, 0)),
+                          source=SimpleNamespace(t=7.0), servo=SimpleNamespace(stale_s=0.3))
+    row = LogRow(7.0, Phase.WAIT, "", 1.48, math.nan, math.nan, math.nan, math.nan, math.nan,
+                 0, 0, 15.0, 60.0, 0.0, 1.763)
+    return Judge(sim), world, row  # type: ignore[arg-type]
+
+
+def test_a_box_put_down_touching_the_robot_is_hit_only_when_the_robot_closes_on_it() -> None:
+    """Dev seed 8's trial 45: the scene pushed the target box 24 cm farther, to 4.6 cm of the
+    robot's centre, while the robot stood (its probe had not yet moved it): the robot did
+    not hit it. Backing 1.1 cm on into it afterwards, it did."""
+    judge, world, row = _judged_world()
+    assert judge(row) == ""
+    world.boxes = (Box(1.717, -0.50, -0.18, 0.38),)  # the move event, between two steps
+    assert judge(row) == ""
+    world.robot.z_m -= 0.005  # within CLOSED_ON_M: the wheels' run-down, noise
+    assert judge(row) == ""
+    world.robot.z_m -= 0.006
+    assert judge(row) == "hit the object"
+
+
+def test_a_box_the_robot_drives_up_to_is_hit() -> None:
+    """A box that stood where it is all along: coming within the contact zone is a hit."""
+    judge, world, row = _judged_world()
+    world.robot.z_m = 1.48 + 0.055
+    assert judge(row) == "hit the object"
+
