@@ -993,7 +993,8 @@ class Servo:
         self.acquisition = Acquisition(self.cfg.acquire,
                                        facing_away=None if probe or not proven
                                        else old.facing_away,
-                                       again=why)
+                                       again=why,
+                                       spent_s=0.0 if proven else self.acquisition.driven_s())
         c = Controller(old.target_m, self.control)
         c.cfg, c.keep_out, c.trim, c.facing_away = old.cfg, old.keep_out, old.trim, \
             old.facing_away

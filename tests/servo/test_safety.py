@@ -1,6 +1,7 @@
 """Safety: a hidden marker stops the robot within one frame; a robot that stops answering is
 reported and its own link-loss stop holds it; the trials' judge calls a box the scene puts down
-touching the robot a hit only when the robot then closes on it."""
+touching the robot a hit only when the robot then closes on it; a probe started again drives
+within probe_s in all."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ import pytest
 
 from host.emulator.emulator import Faults
 from host.link.client import LinkError
+from host.servo.acquire import NOT_MOVED, AcquireConfig, Acquisition
 from host.servo.loop import LogRow
 from host.servo.phase import Phase
 from host.sim.trials import Judge
@@ -85,3 +87,29 @@ def test_a_box_the_robot_drives_up_to_is_hit() -> None:
     world.robot.z_m = 1.48 + 0.055
     assert judge(row) == "hit the object"
 
+
+def test_a_probe_started_again_drives_within_probe_s_in_all() -> None:
+    """Dev seed 8's trial 45 and 105's 7: a probe on a look-alike (it does not move) cut short
+    by a stale frame (a drop burst, a freeze, a knock) began again with a whole probe_s of
+    its own: 0.9 + 1.5 s of driving on a sighting never proven, the robot's travel beyond
+    what one probe allows. Now the clock is probe_s in all: the second start decides on its
+    own sightings (not moved: a look-alike) when the first's time and its own make probe_s."""
+    cfg = AcquireConfig()
+    acq = Acquisition(cfg)
+    t, dt = 0.0, 0.066
+    while acq.phase != Phase.PROBE:  # find and measure, standing at 1.62 m
+        t += dt
+        acq.update(t, (1.62, 0.3), 11.0)
+    driven = 0.0
+    while t < 0.9 + dt / 2:  # the first start, cut short after 0.9 s
+        t += dt
+        order = acq.update(t, (1.62, 0.3), 11.0)
+        driven += dt if order.left else 0.0
+    acq.interrupted(t + dt)
+    t += 0.2
+    while not acq.fault and t < 10.0:  # the second start, to its end
+        t += dt
+        order = acq.update(t, (1.62, 0.3), 11.0)
+        driven += dt if order.left else 0.0
+    assert acq.fault == NOT_MOVED
+    assert driven <= cfg.probe_s + dt
