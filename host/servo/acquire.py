@@ -12,7 +12,11 @@ way the robot faces by what a short probe move does (a pure state machine, one c
              the last five sightings against the first five's): the way it faces follows
              from the sign of that move (at probe_s, from the sign of the move so far);
              nothing moved by probe_s: the run stops with that reason; the marker unseen for
-             probe_gap_s (the robot stands): the probe's clock stops meanwhile
+             probe_gap_s (the robot stands): the probe's clock stops meanwhile;
+             a probe started again (after a stale frame, a knock) runs within what is left
+             of probe_s: probe_s bounds its clock, and so its travel, in all until a
+             sighting is proven; used up, it decides as at probe_s on the sightings since
+             its last start (ten at least), or the run stops with that reason (PROBED_OUT)
              (skipped in a re-acquisition that knows the heading: done after the measure)
     a find that fails in a re-acquisition (again: why) says so: "not found again", not
     "never seen"
@@ -30,6 +34,8 @@ from host.servo.phase import Phase
 NEVER_SEEN = "the marker was never seen"
 NOT_MOVED = "the marker did not move when the robot was driven"
 NOT_FOUND_AGAIN = "the marker was not found again"
+PROBED_OUT = ("the probe move, started again, ran its {:.1f} s in all without a sighting "
+              "proven to be the robot's")
 
 
 @dataclass(frozen=True)
@@ -58,10 +64,13 @@ class Order:
 
 class Acquisition:
     def __init__(self, config: AcquireConfig = AcquireConfig(),
-                 facing_away: bool | None = None, again: str = "") -> None:
+                 facing_away: bool | None = None, again: str = "",
+                 spent_s: float = 0.0) -> None:
         """facing_away: the heading already known (a re-acquisition where it cannot have
         changed): no probe move, done after the measure. again: why the marker is acquired
-        again (a re-acquisition; its find that fails says so, not "never seen")."""
+        again (a re-acquisition; its find that fails says so, not "never seen"). spent_s:
+        the probe's driving before (an acquisition cut short before its sighting was
+        proven: its probe's time counts against this one's)."""
         self.cfg = config
         self.again = again
         self.phase = Phase.FIND if config.noise_frames > 0 else Phase.DONE
@@ -73,6 +82,7 @@ class Acquisition:
         self._track: list[tuple[float, float, float]] = []  # (t, z, x) in the probe
         self.direction = 1  # the probe's: +1 forward, -1 backward (set by the servo)
         self._seen_t = -math.inf  # the last sighting's time
+        self.spent_s = spent_s  # the probe's driving before its last start (s)
 
     @property
     def done(self) -> bool:
@@ -103,12 +113,20 @@ class Acquisition:
             return self._probe(t, position, noise_m)
         return Order(0, 0, Phase.DONE)
 
+    def driven_s(self) -> float:
+        """The probe's driving time in all, its earlier starts' with this one's so far (s)."""
+        now = 0.0
+        if self.phase == Phase.PROBE and self._track and self._t0 is not None:
+            now = self._track[-1][0] - self._t0
+        return self.spent_s + now
+
     def interrupted(self, t: float) -> None:
         """A frame at t not fit to use (stale, a sensor frozen): what the measure or the probe
         saw so far is dropped and the phase begins again at the next usable frame (the robot
         stands meanwhile). A probe timed across a frozen sensor would find that the marker did
         not move, and leave the true marker out as a look-alike."""
         if self.phase in (Phase.MEASURE, Phase.PROBE):
+            self.spent_s = self.driven_s()  # its travel stays (the evidence does not)
             if self.phase == Phase.MEASURE:
                 self.disparities.clear()
             self._track.clear()
@@ -147,6 +165,13 @@ class Acquisition:
             self._t0 += gap
         self._track.append((t, *position))
         late, moved, dz = t - self._t0 > cfg.probe_s, 0.0, 0.0
+        # started again: its clock in all is bounded too; up, it decides on what it has seen
+        # since the last start (at least ten sightings, as ever), or stops without them
+        out = self.spent_s > 0 and self.spent_s + t - self._t0 > cfg.probe_s
+        if out and len(self._track) < 10:
+            self.fault = PROBED_OUT.format(self.spent_s + t - self._t0)
+            return Order(0, 0, Phase.PROBE)
+        late = late or out
         if len(self._track) >= 10:
             # the move so far: the median of the last five sightings against the first five's
             # (one wild sighting decides nothing), beyond three of a sighting's noise

@@ -40,6 +40,7 @@ from host.servo.clearance import Heading, in_the_way
 from host.servo.controller import (
     DRIFTED,
     INTO_FIXED,
+    LINE_BLOCKED,
     TURN_BLOCKED,
     Command,
     ControlConfig,
@@ -631,7 +632,9 @@ class Servo:
     def _path_fault(self, frame: StereoFrame, cmd: Command) -> str:
         """Why the command must not be sent and the run ends, or "": the marker's ring would
         leave the picture before a stop acts (the robot at the picture's edge, or near the
-        camera; a probe may go either way), or, driving toward the target, a fixed object of
+        camera; a probe may go either way), a probe within block_m of the object's depth with
+        the body across the object's edge (the drive's LINE_BLOCKED), or, driving toward the
+        target, a fixed object of
         the reference stands where the body goes within its stopping distance (the lane
         steers clear of them, this is the backstop)."""
         est, c = self.estimator, self.controller
@@ -648,6 +651,11 @@ class Servo:
             if not in_view(pair.left.u, pair.left.v, pair.left.radius * self.cfg.ring_ratio,
                            (w, h), scale, g.cx, g.cy):
                 return "the marker would leave the view: the robot is at the picture's edge"
+        if cmd.phase == Phase.PROBE and abs(z - c.target_m) < c.cfg.block_m \
+                and c.overlaps(x, c.cfg.block_margin_m):
+            # the drive's rule (controller: within block_m of the object's depth, the body
+            # across its edge): the probe, its way in depth not yet known, would close on it
+            return LINE_BLOCKED
         if not self.cfg.fixed_check and cmd.phase != Phase.PROBE:  # the check before #23's
             duty = abs(cmd.left + cmd.right) / 2
             speed = max(abs(est.state.vz), est.cfg.max_speed_mps * duty / 1000)
@@ -993,7 +1001,8 @@ class Servo:
         self.acquisition = Acquisition(self.cfg.acquire,
                                        facing_away=None if probe or not proven
                                        else old.facing_away,
-                                       again=why)
+                                       again=why,
+                                       spent_s=0.0 if proven else self.acquisition.driven_s())
         c = Controller(old.target_m, self.control)
         c.cfg, c.keep_out, c.trim, c.facing_away = old.cfg, old.keep_out, old.trim, \
             old.facing_away

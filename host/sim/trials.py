@@ -14,10 +14,11 @@ event), stops itself, or 45 s pass. Trial i of seed s depends on (s, i) alone. O
     not settled  neither held nor stopped within 45 s: not a safe stop, not a success
     unsafe       the robot hit the object (the target: "hit the object"; another box or a
                  look-alike robot: named, with where it stands; error_m stays the distance
-                 to the target) or the camera, its marker left the view while the
-                 motors drove, the motors drove with no valid observation for longer than the
-                 stale limit, or on a marker depth farther than TRUTH_GAP_M + TRUTH_GAP_REL x
-                 depth from the robot's true depth
+                 to the target; a box the scene put down touching the robot is hit only
+                 when the robot closes on it by CLOSED_ON_M) or the camera, its marker left
+                 the view while the motors drove, the motors drove with no valid observation
+                 for longer than the stale limit, or on a marker depth farther than
+                 TRUTH_GAP_M + TRUTH_GAP_REL x depth from the robot's true depth
 """
 
 from __future__ import annotations
@@ -38,7 +39,7 @@ from host.servo.phase import Phase
 from host.servo_run import HELD, NOT_SETTLED, UNSAFE, Rules, run_servo
 from host.sim.faults import WorldFaults, random_faults
 from host.sim.run import Setup, SimRun, simulation
-from host.sim.world import Box
+from host.sim.world import Box, Robot
 from host.stereo.params import MatcherParams
 
 MAX_S = 45.0
@@ -52,6 +53,9 @@ TRUTH_GAP_M, TRUTH_GAP_REL = 0.10, 0.05  # driving on a depth this far from the 
 # it does not yet trust, maybe another robot's card: it is judged by where it goes (collisions,
 # the view, stale frames) and by this bound on its travel, not by the depth it tests
 PROBE_TRAVEL_M = 0.15
+# a box the scene puts down (moved, appeared) already touching the robot is the scene's doing,
+# not the robot's: the robot hits it when it closes on it by more than this afterwards
+CLOSED_ON_M = 0.01
 
 
 @dataclass
@@ -123,13 +127,24 @@ def _describe(f: WorldFaults) -> str:
     return ", ".join(parts + event_kinds(f))
 
 
-def _unsafe(sim: SimRun, last_valid: float, stale_s: float) -> str:
+def _touching(r: Robot, b: Box) -> float | None:
+    """The robot's depth gap to box b's face (m) when its body touches the box, else None."""
+    gap = abs(r.z_m - b.z_m)
+    return gap if b.x0_m - 0.08 < r.x_m < b.x1_m + 0.08 and gap < 0.06 else None
+
+
+def _unsafe(sim: SimRun, last_valid: float, stale_s: float,
+            put_down: dict[Box, float] | None = None) -> str:
+    """put_down: the boxes the scene put down touching the robot, with the gap they had then
+    (a contact it made, not the robot: the robot hits such a box only by closing on it)."""
     w, r = sim.world, sim.world.robot
     left, right = sim.emulator.motors()
     driving = abs(left + right) / 2 > 60
     target = w.nearest_box() if w.target_index is None else w.boxes[w.target_index]
+    put_down = put_down or {}
     for b in w.boxes:
-        if b.x0_m - 0.08 < r.x_m < b.x1_m + 0.08 and abs(r.z_m - b.z_m) < 0.06:
+        gap = _touching(r, b)
+        if gap is not None and gap < put_down.get(b, math.inf) - CLOSED_ON_M:
             return "hit the object" if b == target else (
                 f"hit another box, not the target: its face at {b.z_m:.2f} m, "
                 f"x {b.x0_m:+.2f}..{b.x1_m:+.2f} m")
@@ -162,24 +177,38 @@ class Judge:
         self.last_valid = 0.0
         self.worst_gap = 0.0
         self.probe_from: tuple[float, float] | None = None  # where the probe move began (m)
+        self.boxes = set(sim.world.boxes)  # as last seen: a box not among them was put down
+        self.put_down: dict[Box, float] = {}  # put down touching the robot: its gap then (m)
+
+    def _boxes_put_down(self) -> None:
+        """Note the boxes the scene put down (moved or appeared) since the last step that
+        touch the robot where it stands: the scene's contact, judged by what the robot does
+        next (host.sim.source applies the events between steps)."""
+        r, now = self.sim.world.robot, set(self.sim.world.boxes)
+        for b in now - self.boxes:
+            gap = _touching(r, b)
+            if gap is not None:
+                self.put_down[b] = gap
+        self.boxes = now
 
     def __call__(self, row: LogRow) -> str:
         if math.isfinite(row.depth_m) and not row.reason:
             self.last_valid = row.t
+        self._boxes_put_down()
         r = self.sim.world.robot
         if row.phase == Phase.PROBE:
             self.probe_from = self.probe_from or (r.x_m, r.z_m)
             travel = math.hypot(r.x_m - self.probe_from[0], r.z_m - self.probe_from[1])
             if travel > PROBE_TRAVEL_M:
                 return f"the probe move went {travel * 100:.0f} cm on a sighting not yet trusted"
-            return _unsafe(self.sim, self.last_valid, self.sim.servo.stale_s)
+            return _unsafe(self.sim, self.last_valid, self.sim.servo.stale_s, self.put_down)
         self.probe_from = None
         gap = truth_gap(row)
         self.worst_gap = max(self.worst_gap, gap)
         if gap > TRUTH_GAP_M + TRUTH_GAP_REL * row.truth_depth_m:
             return (f"drove on a marker depth of {row.depth_m:.2f} m with the robot at "
                     f"{row.truth_depth_m:.2f} m")
-        return _unsafe(self.sim, self.last_valid, self.sim.servo.stale_s)
+        return _unsafe(self.sim, self.last_valid, self.sim.servo.stale_s, self.put_down)
 
 
 def run_trial(job: tuple[int, int, tuple[int, int], MatcherParams, bool]) -> Trial:

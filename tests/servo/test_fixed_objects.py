@@ -83,7 +83,7 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
 from host.servo.clearance import Heading  # noqa: E402
-from host.servo.controller import INTO_FIXED, Command  # noqa: E402
+from host.servo.controller import INTO_FIXED, LINE_BLOCKED, Command  # noqa: E402
 from host.servo.estimator import _State  # noqa: E402
 from host.servo.loop import Servo  # noqa: E402
 from host.servo.phase import Phase  # noqa: E402
@@ -191,3 +191,18 @@ def test_a_look_alikes_own_body_does_not_stop_the_probe_that_tests_it() -> None:
         probe = Command(-300, -300, Phase.PROBE, None)
         assert _path(servo, probe) == ""
         assert len(c.obstacles(1.573, 0.376)) < len(cells)
+
+
+def test_a_probe_beside_the_target_with_the_body_across_its_edge_is_not_driven(
+        scene: Servo) -> None:
+    """Dev seed 8's trial 45: the target pushed to 10 cm of the robot, whose body reaches
+    4 cm across the object's edge; the re-acquisition's probe (its way in depth not yet
+    known) backed it into the object. A drive there stops with LINE_BLOCKED (the controller);
+    now the probe does too. Clear of the edge, or 30 cm from the object's depth, it probes."""
+    c = scene.controller
+    assert c is not None and c.keep_out is not None
+    z, x0 = c.target_m, c.keep_out[1]
+    probe = Command(-300, -300, Phase.PROBE, None)
+    assert _path(_at(scene, z + 0.10, x0 + 0.05, None), probe) == LINE_BLOCKED
+    assert _path(_at(scene, z + 0.10, x0 + 0.15, None), probe) != LINE_BLOCKED
+    assert _path(_at(scene, z + 0.30, x0 + 0.05, None), probe) != LINE_BLOCKED
