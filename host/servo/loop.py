@@ -243,7 +243,8 @@ class Servo:
         self._strips: StripMap | None = None  # the re-measure's map, a band per frame
         self._remeasure_t: float | None = None
         self._cmd = Command(0, 0, Phase.WAIT, None)  # the command in force
-        self._statics: list[tuple[float, float]] = []  # where non-moving look-alikes stand
+        self._statics: list[tuple[float, float, float]] = []  # where non-moving look-alikes
+        # stand: (u, v) px in the left image, depth (m)
         self.heading = Heading()  # the robot's heading from its travel (clearance.py)
         self._probe_at: tuple[int, float, float] | None = None  # (acquisition, z, x) at its probe
         self._still_since: float | None = None  # standing since (the drift check)
@@ -380,10 +381,15 @@ class Servo:
         b = pair.left
         return Sighting(t, pair.disparity, b.u, 2 * b.radius / (1 + min(1.0, b.aspect)))
 
-    def _static(self, pair: MarkerPair) -> bool:
-        """Whether the pair is where a marker that did not move with the robot was seen."""
+    def _static(self, pair: MarkerPair, depth: bool = False) -> bool:
+        """Whether the pair is where a marker that did not move with the robot was seen; with
+        depth, also at its depth, within two of the robot's half widths: the robot's body
+        would overlap the look-alike's (so with an estimate too: the estimate kept through a
+        loss may have a gate wide enough to reach it, seed 11's trial 907)."""
+        body = 2 * self.control.half_width_m
+        z = self.geometry.depth_m(pair.disparity) if depth and pair.disparity > 0 else math.inf
         return any(abs(pair.left.u - u) + abs(pair.left.v - v) < 3 * pair.left.radius + 4
-                   for u, v in self._statics)
+                   and (not depth or abs(z - zs) < body) for u, v, zs in self._statics)
 
     def _see(self, frame: StereoFrame) -> _Seen:
         """The marker: the best candidate the estimator's gate admits and block matching over
@@ -414,7 +420,7 @@ class Servo:
                                            whole=whole)
             checked = 0
             for pair in candidates:
-                if self.estimator.state is None and self._static(pair):
+                if self._static(pair, depth=self.estimator.state is not None):
                     continue  # shown not to move with the robot: not its marker
                 why = self.estimator.gate(self._sighting(frame.t_left, pair))
                 if why:
@@ -700,7 +706,8 @@ class Servo:
                 and len(self._statics) < self.cfg.acquire_tries - 1:
             # what was taken for the marker did not move with the robot (another robot, a
             # disc on the wall): acquire again, leaving it out
-            self._statics.append((self.last_pair.left.u, self.last_pair.left.v))
+            self._statics.append((self.last_pair.left.u, self.last_pair.left.v,
+                                  self.geometry.depth_m(self.last_pair.disparity)))
             self.notes.append(f"the marker seen at ({self.last_pair.left.u:.0f}, "
                               f"{self.last_pair.left.v:.0f}) px did not move with the robot: "
                               f"looking for another")

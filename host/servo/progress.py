@@ -5,7 +5,10 @@ state machine, one call a frame).
 Progress is either of:
   - a step: the depth error's magnitude below its least so far by step_m, or by half the
     least when that is smaller (not below min_step_m: noise); the least is forgotten when the
-    target's depth moves by step_m (a new goal);
+    target's depth moves by step_m (a new goal), and the count restarts then if an error was
+    measured since the last goal began (a target that keeps moving while the servo measures
+    nothing against it, the re-measure taking the unseen robot's own body for it, restarts
+    nothing: seed 11's trial 322);
   - a steady hold: holding hold_s without a break (each frame of it counts).
 No progress for stall_s while the servo commands (waits that recovery.py bounds do not count:
 the robot stands for a reason with its own limit) ends the run: the robot that oscillates
@@ -41,6 +44,7 @@ class Progress:
         self._hold_t0: float | None = None  # the hold without a break began then
         self._paused = 0.0  # time in bounded waits since the last progress
         self._last_t: float | None = None
+        self._measured = True  # an error measured since the goal began (the first goal counts)
         self.last_phases: list[Phase] = []  # the phases since the last progress, in order
 
     def update(self, t: float, phase: Phase, error_m: float | None, target_m: float,
@@ -55,7 +59,11 @@ class Progress:
             self.since = t
         if self.target is None or abs(target_m - self.target) >= cfg.step_m:
             self.target, self.best = target_m, math.inf  # a new goal
-            self._progress(t)
+            if self._measured:
+                self._progress(t)
+            self._measured = False
+        if error_m is not None and math.isfinite(error_m):
+            self._measured = True
         if waiting:
             self._paused += dt
         if phase == Phase.HOLD:
@@ -76,8 +84,9 @@ class Progress:
 
     def detail(self) -> str:
         """What the servo did since its last progress, for the run's notes."""
-        return (f"the least depth error was {self.best * 100:.1f} cm; since then: "
-                f"{', '.join(self.last_phases)}")
+        least = (f"the least depth error was {self.best * 100:.1f} cm"
+                 if math.isfinite(self.best) else "no depth error measured")
+        return f"{least}; since then: {', '.join(self.last_phases)}"
 
     def _progress(self, t: float) -> None:
         self.since, self._paused = t, 0.0

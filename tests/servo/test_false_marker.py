@@ -7,6 +7,9 @@ from __future__ import annotations
 
 import math
 
+from host.camera.source import StereoFrame
+from host.servo.loop import Servo
+from host.servo.marker import MarkerPair, marker_candidates
 from host.sim.faults import Event, WorldFaults
 from host.sim.run import Setup, simulation
 
@@ -54,3 +57,38 @@ def test_another_robot_nearer_the_camera_is_not_taken_for_this_one() -> None:
         assert sim.servo.outcome() == ("held", "")
         assert abs(sim.depth_error_m()) <= 0.02
         assert any("did not move with the robot" in n for n in sim.servo.notes)
+
+
+def test_a_look_alike_left_out_stays_out_when_the_estimate_would_admit_it() -> None:
+    """Seed 11's trial 907: a look-alike shown not to move (left out by the acquisition) was
+    admitted again 7 s later, during the spin back after the robot's own card was lost while
+    driving: the estimate kept from before the loss had grown its gate over the look-alike's
+    place, 0.25 m from it, and only a servo without an estimate left look-alikes out. Here the
+    decoy is left out, the robot acquired, then its card hidden and the estimate put 3 cm from
+    the decoy (inside the gate): the decoy must still not be taken for the marker."""
+    faults = WorldFaults(events=(Event(0.0, "decoy", z_m=1.5, x_m=0.33),))
+    with simulation(Setup((320, 240), 2.9, faults=faults)) as sim:
+        servo = sim.servo
+        while sim.source.t < 15 and not (servo.acquisition.done and servo._statics):
+            sim.step()
+        assert servo.acquisition.done and servo._statics  # the decoy was left out
+        sim.world.robot.marker_hidden = True
+        state = servo.estimator.state
+        assert state is not None
+        frame = sim.source.read()
+        decoy = servo._sighting(frame.t_left, _decoy_pair(servo, frame))
+        z, x = servo.estimator.position(decoy)
+        assert abs(z - 1.5) < 0.1  # it is the decoy's card
+        state.z, state.x, state.vz, state.vx, state.t = z + 0.03, x, 0.0, 0.0, frame.t_left
+        assert servo.estimator.gate(decoy) == ""  # the gate alone would admit it
+        seen = servo._see(frame)
+        assert seen.pair is None
+
+
+def _decoy_pair(servo: Servo, frame: StereoFrame) -> MarkerPair:
+    """The decoy's marker pair in the frame (the robot's own card is hidden)."""
+    cfg, g = servo.cfg, servo.geometry
+    pairs = marker_candidates(frame.left, frame.right, cfg.marker_kind, cfg.marker_radius_m,
+                              g.baseline_m, None, whole=True)
+    assert pairs
+    return pairs[0]

@@ -59,6 +59,31 @@ def test_bounded_waits_and_a_new_target_restart_the_count() -> None:
     assert p.update(t0 + 5.1, "drive", 0.3, 1.5).startswith(NO_PROGRESS)
 
 
+def test_a_target_that_keeps_moving_while_nothing_is_measured_restarts_no_count() -> None:
+    """Seed 11's trial 322: the card lost at the end of the acquisition, the robot stood in
+    "wait" for 41 s while the re-measure took its own body, drifting out of the region left
+    out, for the target: the target's depth changed by 2-16 cm every 2-15 s, each change a new
+    goal that restarted the count, and the run ended "not settled" at 45 s. A new goal restarts
+    the count once; again only after an error has been measured against it."""
+    cfg = ProgressConfig(stall_s=5.0)
+    p = Progress(cfg)
+    t, targets = 0.0, [1.2, 1.1, 0.95, 0.92, 0.94, 1.1, 0.95, 0.92]
+    why = ""
+    for k in range(int(20 / DT)):
+        t = k * DT
+        why = p.update(t, "wait", None, targets[int(t / 2.5) % len(targets)])
+        if why:
+            break
+    assert why.startswith(NO_PROGRESS) and 4.9 < t < 5.2
+    # measured against, a new goal restarts the count, as it did
+    p = Progress(cfg)
+    for k in range(int(4 / DT)):
+        assert not p.update(k * DT, "drive", 0.3, 1.2)
+    assert not p.update(4.0, "wait", None, 1.5)
+    assert not p.update(8.9, "wait", None, 1.5)
+    assert p.update(9.1, "wait", None, 1.5).startswith(NO_PROGRESS)
+
+
 def test_the_servo_names_a_hold_it_cannot_keep_instead_of_running_out_of_time() -> None:
     """Closed loop (the constructed case of dev seed 102's trial 74): at the target the marker
     is unseen three frames in six (a card at the edge of what the search finds), so the servo
