@@ -325,8 +325,8 @@ def test_the_trial_judge_sees_a_body_pressed_against_a_boxs_side() -> None:
 
 
 def test_the_trial_judge_leaves_a_body_beside_a_box_with_clearance() -> None:
-    """1 cm clear of the face's end, straight or turned, and a body 2 cm behind the face's
-    line (nothing stands behind a face) are no hit."""
+    """1 cm clear of the face's end, straight or turned, and a body centred 10 cm behind the
+    face's line, its near end 2 cm behind it (nothing stands behind a face), are no hit."""
     assert _judge_robot(0.22 - 0.09, 1.8) == ""
     assert _judge_robot(0.22 - 0.08 * math.sqrt(2) - 0.01, 1.8, 45.0) == ""
     assert _judge_robot(0.3, 1.8 + 0.10) == ""
