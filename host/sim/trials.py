@@ -12,10 +12,12 @@ event), stops itself, or 45 s pass. Trial i of seed s depends on (s, i) alone. O
     missed       holding, but farther than that from the object's true depth
     stopped      a safe stop, with its reason (target vanished, marker lost, link error ...)
     not settled  neither held nor stopped within 45 s: not a safe stop, not a success
-    unsafe       the robot hit the object (the target: "hit the object"; another box or a
-                 look-alike robot: named, with where it stands; error_m stays the distance
-                 to the target; a box the scene put down touching the robot is hit only
-                 when the robot closes on it by CLOSED_ON_M) or the camera, its marker left
+    unsafe       the robot's body (its footprint with its heading) hit the object (the
+                 target: "hit the object"; another box, the back wall or a look-alike robot:
+                 named, with where it stands; a box's face or its side, an end of the face:
+                 the world's boxes are faces; error_m stays the distance to the target; a
+                 box the scene put down touching the robot is hit only when the robot
+                 closes on it by CLOSED_ON_M) or the camera, its marker left
                  the view while the motors drove, the motors drove with no valid observation
                  for longer than the stale limit, or on a marker depth farther than
                  TRUTH_GAP_M + TRUTH_GAP_REL x depth from the robot's true depth
@@ -127,27 +129,54 @@ def _describe(f: WorldFaults) -> str:
     return ", ".join(parts + event_kinds(f))
 
 
-def _touching(r: Robot, b: Box) -> float | None:
-    """The robot's depth gap to box b's face (m) when its body touches the box, else None."""
-    gap = abs(r.z_m - b.z_m)
-    return gap if b.x0_m - 0.08 < r.x_m < b.x1_m + 0.08 and gap < 0.06 else None
+def _extent(r: Robot) -> tuple[float, float]:
+    """Half the robot's body across x and along z with its heading (the world's body: a
+    rectangle body_width_m across, body_length_m long, centred at x_m, z_m)."""
+    c, s = abs(math.cos(r.theta)), abs(math.sin(r.theta))
+    return (c * r.body_width_m / 2 + s * r.body_length_m / 2,
+            s * r.body_width_m / 2 + c * r.body_length_m / 2)
+
+
+def _touching(r: Robot, b: Box) -> tuple[float, float] | None:
+    """How far the robot's body reaches into box b across x and along z (m) when they overlap,
+    else None. The world models a box by its face alone (host.sim.world, the renderer: one
+    layer at z_m, x0..x1, nothing behind it), so the box is that segment: the body hits its
+    face, or its side (an end of the face, across the body's side)."""
+    for ax, az, half in ((math.sin(r.theta), math.cos(r.theta), r.body_length_m / 2),
+                         (math.cos(r.theta), -math.sin(r.theta), r.body_width_m / 2)):
+        centre = r.x_m * ax + r.z_m * az
+        ends = (b.x0_m * ax + b.z_m * az, b.x1_m * ax + b.z_m * az)
+        if max(ends) <= centre - half or min(ends) >= centre + half:
+            return None  # the body's own axes separate them
+    hx, hz = _extent(r)
+    across = min(b.x1_m, r.x_m + hx) - max(b.x0_m, r.x_m - hx)
+    along = hz - abs(r.z_m - b.z_m)
+    return (across, along) if across > 0 and along > 0 else None
 
 
 def _unsafe(sim: SimRun, last_valid: float, stale_s: float,
-            put_down: dict[Box, float] | None = None) -> str:
-    """put_down: the boxes the scene put down touching the robot, with the gap they had then
-    (a contact it made, not the robot: the robot hits such a box only by closing on it)."""
+            put_down: dict[Box, tuple[float, float]] | None = None) -> str:
+    """put_down: the boxes the scene put down touching the robot, with how far the body
+    reached into them then (a contact it made, not the robot: the robot hits such a box only
+    by closing on it, across or along, by CLOSED_ON_M)."""
     w, r = sim.world, sim.world.robot
     left, right = sim.emulator.motors()
     driving = abs(left + right) / 2 > 60
     target = w.nearest_box() if w.target_index is None else w.boxes[w.target_index]
     put_down = put_down or {}
     for b in w.boxes:
-        gap = _touching(r, b)
-        if gap is not None and gap < put_down.get(b, math.inf) - CLOSED_ON_M:
-            return "hit the object" if b == target else (
-                f"hit another box, not the target: its face at {b.z_m:.2f} m, "
-                f"x {b.x0_m:+.2f}..{b.x1_m:+.2f} m")
+        reach = _touching(r, b)
+        was = put_down.get(b)
+        if reach is None or (was is not None and reach[0] <= was[0] + CLOSED_ON_M
+                             and reach[1] <= was[1] + CLOSED_ON_M):
+            continue
+        end = b.x0_m if r.x_m < b.x0_m else b.x1_m if r.x_m > b.x1_m else None
+        part = "" if end is None or reach[1] <= reach[0] else f", its side at x {end:+.2f} m"
+        return ("hit the object" + part) if b == target else (
+            f"hit another box, not the target: its face at {b.z_m:.2f} m, "
+            f"x {b.x0_m:+.2f}..{b.x1_m:+.2f} m{part}")
+    if r.z_m + _extent(r)[1] > w.wall_z_m:
+        return f"hit the back wall at {w.wall_z_m:.2f} m"
     for o in w.decoys:
         if abs(r.z_m - o.z_m) < 0.12 and abs(r.x_m - o.x_m) < r.body_width_m:
             return f"hit the look-alike robot standing at {o.z_m:.2f} m, x {o.x_m:+.2f} m"
@@ -178,7 +207,7 @@ class Judge:
         self.worst_gap = 0.0
         self.probe_from: tuple[float, float] | None = None  # where the probe move began (m)
         self.boxes = set(sim.world.boxes)  # as last seen: a box not among them was put down
-        self.put_down: dict[Box, float] = {}  # put down touching the robot: its gap then (m)
+        self.put_down: dict[Box, tuple[float, float]] = {}  # put down touching: reach then
 
     def _boxes_put_down(self) -> None:
         """Note the boxes the scene put down (moved or appeared) since the last step that
@@ -186,9 +215,9 @@ class Judge:
         next (host.sim.source applies the events between steps)."""
         r, now = self.sim.world.robot, set(self.sim.world.boxes)
         for b in now - self.boxes:
-            gap = _touching(r, b)
-            if gap is not None:
-                self.put_down[b] = gap
+            reach = _touching(r, b)
+            if reach is not None:
+                self.put_down[b] = reach
         self.boxes = now
 
     def __call__(self, row: LogRow) -> str:

@@ -56,6 +56,7 @@ class Robot:
     marker_radius_m: float = 0.03  # the dark disc; the light ring reaches ring_ratio times it
     ring_ratio: float = RING_RATIO
     body_width_m: float = 0.16
+    body_length_m: float = 0.16  # along its heading; the body is this rectangle, centred at x, z
     body_height_m: float = 0.12
     marker_hidden: bool = False  # something between the camera and the card (tests)
     occlusion: float = 0.0  # fraction of the card's width hidden from its left edge

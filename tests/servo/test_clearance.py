@@ -292,3 +292,41 @@ def test_the_trial_judge_names_the_object_that_was_hit() -> None:
     assert other.startswith("hit another box, not the target") and "1.80 m" in other
     robot = _unsafe(world_at(1.5, 0.3, (Robot(x_m=0.35, z_m=1.52),)), 4.99, 0.3)  # type: ignore[arg-type]
     assert robot.startswith("hit the look-alike robot")
+
+
+def _judge_robot(x: float, z: float, heading_deg: float = 0.0) -> str:
+    """The trials' judge over the default world (boxes' faces at 1.2, 1.8 and 2.4 m, the back
+    wall at 3.2 m), the robot driving at x, z with that heading, its observations fresh."""
+    w = World()
+    w.robot.x_m, w.robot.z_m, w.robot.theta = x, z, math.radians(heading_deg)
+    sim = SimpleNamespace(world=w, emulator=SimpleNamespace(motors=lambda: (300, 300)),
+                          source=SimpleNamespace(t=5.0))
+    return _unsafe(sim, 4.99, 0.3)  # type: ignore[arg-type]
+
+
+def test_the_trial_judge_sees_the_body_driven_into_the_back_wall() -> None:
+    """Seed 11's trial 739 (the fixed-object check off) drove the body several cm into the
+    wall at 3.2 m, unseen: the body's far end (8 cm ahead of its centre, more when it is
+    turned) past the wall is a hit; short of it is not."""
+    assert _judge_robot(0.0, 3.15) == "hit the back wall at 3.20 m"
+    assert _judge_robot(0.0, 3.10) == ""  # its end at 3.18 m
+    assert _judge_robot(0.0, 3.10, 30.0) == "hit the back wall at 3.20 m"  # turned: 3.21 m
+
+
+def test_the_trial_judge_sees_a_body_pressed_against_a_boxs_side() -> None:
+    """The world's boxes are faces (one layer at z_m, x0..x1, nothing behind it): a box's side
+    is an end of its face. A body turned 45 degrees beside the end at +0.22 m of the face at
+    1.8 m reaches 1.3 cm past it with its corner; a straight body 7 cm short of the face
+    reaches over it by 1 cm and past its end by 0.5 cm. Both hit its side."""
+    turned = _judge_robot(0.22 - 0.10, 1.8, 45.0)
+    assert turned.startswith("hit another box, not the target: its face at 1.80 m")
+    assert turned.endswith("its side at x +0.22 m")
+    assert _judge_robot(0.22 - 0.075, 1.73).endswith("its side at x +0.22 m")
+
+
+def test_the_trial_judge_leaves_a_body_beside_a_box_with_clearance() -> None:
+    """1 cm clear of the face's end, straight or turned, and a body centred 10 cm behind the
+    face's line, its near end 2 cm behind it (nothing stands behind a face), are no hit."""
+    assert _judge_robot(0.22 - 0.09, 1.8) == ""
+    assert _judge_robot(0.22 - 0.08 * math.sqrt(2) - 0.01, 1.8, 45.0) == ""
+    assert _judge_robot(0.3, 1.8 + 0.10) == ""

@@ -77,8 +77,8 @@ def test_a_box_put_down_touching_the_robot_is_hit_only_when_the_robot_closes_on_
     assert judge(row) == ""
     world.robot.z_m -= 0.005  # within CLOSED_ON_M: the wheels' run-down, noise
     assert judge(row) == ""
-    world.robot.z_m -= 0.006
-    assert judge(row) == "hit the object"
+    world.robot.z_m -= 0.006  # the box's end 2.7 cm inside its body, across: its side
+    assert judge(row) == "hit the object, its side at x -0.18 m"
 
 
 def test_a_box_the_robot_drives_up_to_is_hit() -> None:
