@@ -177,9 +177,9 @@ def _unsafe(sim: SimRun, last_valid: float, stale_s: float,
             f"x {b.x0_m:+.2f}..{b.x1_m:+.2f} m{part}")
     if r.z_m + _extent(r)[1] > w.wall_z_m:
         return f"hit the back wall at {w.wall_z_m:.2f} m"
-    for o in w.decoys:
-        if abs(r.z_m - o.z_m) < 0.12 and abs(r.x_m - o.x_m) < r.body_width_m:
-            return f"hit the look-alike robot standing at {o.z_m:.2f} m, x {o.x_m:+.2f} m"
+    o = w.decoy_touched()
+    if o is not None:
+        return f"hit the look-alike robot standing at {o.z_m:.2f} m, x {o.x_m:+.2f} m"
     if r.z_m < 0.3:
         return "hit the camera"
     u, v, _ = w.marker_truth()

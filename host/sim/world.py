@@ -120,10 +120,13 @@ class World:
         for p in self.people:
             if abs(r.z_m - p.z_m) < 0.1 and abs(r.x_m - p.x_m) < (p.width_m + r.body_width_m) / 2:
                 return "a person"
-        for o in self.decoys:
-            if abs(r.z_m - o.z_m) < 0.12 and abs(r.x_m - o.x_m) < r.body_width_m:
-                return "another robot"
-        return ""
+        return "another robot" if self.decoy_touched() is not None else ""
+
+    def decoy_touched(self) -> Robot | None:
+        """The look-alike robot the robot's body overlaps, or None."""
+        r = self.robot
+        return next((o for o in self.decoys
+                     if abs(r.z_m - o.z_m) < 0.12 and abs(r.x_m - o.x_m) < r.body_width_m), None)
 
     def step(self, dt: float, duty_left: float, duty_right: float) -> None:
         """Move the robot for dt seconds under the duties its wheels get (permille), through
