@@ -739,16 +739,24 @@ class Servo:
         kind = self.estimator.motion(t, self._cmd.left, self._cmd.right, c.facing_away,
                                      admitted)
         if kind == AGAINST:
-            self.flips += 1
-            if self.flips > MAX_FLIPS:
-                self.stop_reason = AGAINST_REASON
-                return
-            c.facing_away = not c.facing_away
-            c.history.clear()
-            self.notes.append("the depth moved against the commanded direction: the robot "
-                              "faces the other way")
+            self._turn_round("the depth moved against the commanded direction")
         elif kind == STILL:
             self.stop_reason = STILL_REASON
+
+    def _turn_round(self, why: str) -> bool:
+        """The depth moved against the commanded direction (why): the robot faces the other way
+        (the controller turns it round), or, past MAX_FLIPS such corrections, the run stops
+        (False)."""
+        assert self.controller is not None
+        c = self.controller
+        self.flips += 1
+        if self.flips > MAX_FLIPS:
+            self.stop_reason = AGAINST_REASON
+            return False
+        c.facing_away = not c.facing_away
+        c.history.clear()
+        self.notes.append(f"{why}: the robot faces the other way")
+        return True
 
     # ----------------------------------------------------------------------------- step
 
@@ -879,16 +887,10 @@ class Servo:
                 return self._keep_in_view(aspect, cmd)  # a card missing a few frames (far,
                 # small) is waited for
             reason = "the marker was lost while driving"
-            if self._drove_against():
-                self.flips += 1
-                if self.flips > MAX_FLIPS:
-                    self.stop_reason = AGAINST_REASON
-                    return Command(0, 0, Phase.STOP, None)
-                c.facing_away = not c.facing_away
-                c.history.clear()
-                self.notes.append("over the drives before the marker was lost the depth moved "
-                                  "against the commanded direction: the robot faces the other "
-                                  "way")
+            if self._drove_against() and not self._turn_round(
+                    "over the drives before the marker was lost the depth moved against the "
+                    "commanded direction"):
+                return Command(0, 0, Phase.STOP, None)
             if not self._recover(t, LOST, reason):
                 return Command(0, 0, Phase.STOP, None)
             # which way the card turned: since it was square, else by the last drives
