@@ -487,18 +487,19 @@ class Servo:
         shifted, the run stops."""
         assert self.tracker is not None and self.controller is not None
         moved = camera_moved(disp, self.floor, reference=self.reference_map)
-        if moved and self._reference_image is not None:  # and the picture itself moved: an
-            # object put down over the floor's rows shifts their disparity too
+        if self._reference_image is not None:  # the picture's shift, measured once a frame
             dy = vertical_shift_px(self._reference_image, frame.left)
-            if abs(dy) >= self.cfg.moved_rows * self.geometry.focal_px:
+            limit = self.cfg.moved_rows * self.geometry.focal_px
+            if moved and abs(dy) >= limit:  # and the picture itself moved: an object put
+                # down over the floor's rows shifts their disparity too
                 self._reref, self._reref_fails = [], 0
                 self._recover(frame.t_left, MOVED, f"{moved} (the picture moved {dy:+.1f} rows)")
                 return
-        if self._reference_image is not None and abs(vertical_shift_px(
-                self._reference_image, frame.left)) < self.cfg.moved_rows * self.geometry.focal_px:
-            # the target's picture while the camera is where it was (a moved camera that the
-            # floor did not show yet must not give the picture the knock is measured against)
-            self._target_picture = (reference_image(frame.left), hide)
+            if abs(dy) < limit:
+                # the target's picture while the camera is where it was (a moved camera that
+                # the floor did not show yet must not give the picture the knock is measured
+                # against)
+                self._target_picture = (reference_image(frame.left), hide)
         clean = without_floor(disp, self.floor)
         before = self.tracker.target
         target = self.tracker.update(clean, lambda t: views_agree(
