@@ -253,8 +253,7 @@ class Renderer:
         if r.z_m <= 0.2:
             return
         d = g.focal_px * g.baseline_m / r.z_m
-        half_w = (abs(math.cos(r.theta)) * r.body_width_m / 2
-                  + abs(math.sin(r.theta)) * r.body_length_m / 2)
+        half_w = r.half_extent()[0]
         x0, y0 = self._project(r.x_m - half_w, r.body_height_m, r.z_m)
         x1, y1 = self._project(r.x_m + half_w, 0.02, r.z_m)
         blurred = max(abs(blur_px[0]), abs(blur_px[1])) >= 0.5

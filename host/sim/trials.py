@@ -129,14 +129,6 @@ def _describe(f: WorldFaults) -> str:
     return ", ".join(parts + event_kinds(f))
 
 
-def _extent(r: Robot) -> tuple[float, float]:
-    """Half the robot's body across x and along z with its heading (the world's body: a
-    rectangle body_width_m across, body_length_m long, centred at x_m, z_m)."""
-    c, s = abs(math.cos(r.theta)), abs(math.sin(r.theta))
-    return (c * r.body_width_m / 2 + s * r.body_length_m / 2,
-            s * r.body_width_m / 2 + c * r.body_length_m / 2)
-
-
 def _touching(r: Robot, b: Box) -> tuple[float, float] | None:
     """How far the robot's body reaches into box b across x and along z (m) when they overlap,
     else None. The world models a box by its face alone (host.sim.world, the renderer: one
@@ -148,7 +140,7 @@ def _touching(r: Robot, b: Box) -> tuple[float, float] | None:
         ends = (b.x0_m * ax + b.z_m * az, b.x1_m * ax + b.z_m * az)
         if max(ends) <= centre - half or min(ends) >= centre + half:
             return None  # the body's own axes separate them
-    hx, hz = _extent(r)
+    hx, hz = r.half_extent()
     across = min(b.x1_m, r.x_m + hx) - max(b.x0_m, r.x_m - hx)
     along = hz - abs(r.z_m - b.z_m)
     return (across, along) if across > 0 and along > 0 else None
@@ -175,7 +167,7 @@ def _unsafe(sim: SimRun, last_valid: float, stale_s: float,
         return ("hit the object" + part) if b == target else (
             f"hit another box, not the target: its face at {b.z_m:.2f} m, "
             f"x {b.x0_m:+.2f}..{b.x1_m:+.2f} m{part}")
-    if r.z_m + _extent(r)[1] > w.wall_z_m:
+    if r.z_m + r.half_extent()[1] > w.wall_z_m:
         return f"hit the back wall at {w.wall_z_m:.2f} m"
     o = w.decoy_touched()
     if o is not None:

@@ -61,6 +61,13 @@ class Robot:
     marker_hidden: bool = False  # something between the camera and the card (tests)
     occlusion: float = 0.0  # fraction of the card's width hidden from its left edge
 
+    def half_extent(self) -> tuple[float, float]:
+        """Half the body's extent across x and along z with its heading (m): the rectangle
+        body_width_m across and body_length_m long, turned by theta."""
+        c, s = abs(math.cos(self.theta)), abs(math.sin(self.theta))
+        return (c * self.body_width_m / 2 + s * self.body_length_m / 2,
+                s * self.body_width_m / 2 + c * self.body_length_m / 2)
+
 
 @dataclass(frozen=True)
 class Person:
