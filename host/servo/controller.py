@@ -77,9 +77,8 @@ class ControlConfig:
     block_m: float = 0.15  # within this depth of the object, the body must be clear of it
     block_margin_m: float = 0.02  # by this much (the object's edge is measured to a pixel or two)
     turn_radius_m: float = 0.115  # a turn in place sweeps this circle: half the body's diagonal
-    pass_m: float = 0.13  # a straight run keeps fixed objects' cell centres this far from the
-    # centre's path: a circle round the body's side (8 cm) and the footprint the trials judge
-    # (8 by 6 cm), block_margin_m for the estimate and half a cell
+    half_length_m: float = 0.08  # centre to front (and back): a run sweeps this rectangle
+    # (clearance.swept), turned by the heading, grown by block_margin_m and half a cell
     path_margin_m: float = 0.10  # fixed objects this far beyond the target's depth are in its path
     cell_m: float = 0.02  # the fixed objects' floor cells (perception.fixed_cells)
     push_horizon_s: float = 3.0  # standing, a sideways drift that would bring the body onto

@@ -36,7 +36,14 @@ from host.camera.source import CameraError, StereoFrame, StereoSource
 from host.errors import HostError
 from host.link.client import RobotLink, RobotReset
 from host.servo.acquire import NOT_MOVED, AcquireConfig, Acquisition
-from host.servo.clearance import Heading, in_the_way
+from host.servo.clearance import (
+    Body,
+    Heading,
+    depth_noise_m,
+    in_the_way,
+    motion_heading,
+    run_fault,
+)
 from host.servo.controller import (
     DRIFTED,
     INTO_FIXED,
@@ -580,18 +587,16 @@ class Servo:
         """Whether the command would take the robot's body into a fixed object of the
         reference that is not the target (controller.obstacles: a body standing where the
         robot is seen, or stood for the reference, is no obstacle), in the floor plane at the
-        estimated heading (clearance.in_the_way): a drive or a reversed leg within its
-        stopping distance at the current speed, a probe within the move
-        that ends it and its run-down at the current speed; a spin in place within
-        its circle; standing (settled), a drift that closes within push_horizon_s. The
-        path is the arc the wheels' duties make. The heading is the one travelled
-        (self.heading, within its spread); not known (before
-        the first straight run, after a spin), the controller's facing, within 5 degrees
-        for the whole run and 20 for the run until the heading is learnt (min_run_m and the
-        run-down); a robot facing the camera before the first probe has told so probes its
-        few cm unchecked; a sighting that puts the body inside a fixed object (a disc on a
-        wall) is no robot's, and its probe is not stopped by that object. Why the run ends,
-        or ""."""
+        estimated heading: a drive or a reversed leg within its stopping distance at the
+        current speed (its reaction and run-down, and block_margin_m), a probe within the
+        move that ends it and its run-down at the current speed, the body a rectangle turned
+        by the heading on the arc the wheels' duties make (clearance.run_fault); a spin in
+        place within its circle; standing (settled), a drift that closes within
+        push_horizon_s (clearance.in_the_way). The heading is the one travelled
+        (self.heading, within its spread); not known or too uncertain at the robot's range,
+        the controller's facing (clearance.motion_heading); a sighting that puts the body
+        inside a fixed object (a disc on a wall) is no robot's, and its probe is not stopped
+        by that object. Why the run ends, or ""."""
         est, c = self.estimator, self.controller
         if est.state is None or c is None or not self.cfg.fixed_check:
             return ""
@@ -613,7 +618,9 @@ class Servo:
             return "" if hit is None else INTO_FIXED.format("drift while standing")
         duty = abs(cmd.left + cmd.right) / 2
         speed = max(speed, est.cfg.max_speed_mps * duty / 1000)
-        travel = stopping_distance_m(speed)  # its margin_m: the lane steers clear of these
+        # the stop acts within its reaction and run-down; the cells are where the reference
+        # put them (not a view's first sight), so block_margin_m, not the lane's margin_m
+        travel = stopping_distance_m(speed, margin_m=cfg.block_margin_m)
         if cmd.phase == Phase.PROBE:  # it ends once moved probe_m: that and its run-down
             travel = self.cfg.acquire.probe_m + speed * self.cfg.react_s + cfg.block_margin_m
             inside = cfg.half_width_m - cfg.cell_m / 2
@@ -621,16 +628,10 @@ class Servo:
                 return ""  # a body cannot stand there: a disc on that object, not the robot's
                 # card (the probe finds it out, as it does not move)
         back = cmd.left + cmd.right < 0
-        h, runs = self.heading.value, [(travel, self.heading.spread)]
-        if h is None:  # the facing assumed; 20 degrees off, until the heading is learnt
-            h = 0.0 if c.facing_away else math.pi
-            runs = [(travel, math.radians(5)), (min(travel, self.heading.min_run_m + speed
-                                                    * self.cfg.react_s), math.radians(20))]
-        # the arc the wheels' duties make (their speeds beyond the dead zone curve it more)
-        bend = 2 * (cmd.left - cmd.right) / (self.cfg.wheelbase_m * abs(cmd.left + cmd.right))
-        hits = [in_the_way(cells, s.z, s.x, h + math.pi * back, run, cfg.pass_m, spread, bend)
-                for run, spread in runs]
-        hit = min((x for x in hits if x is not None), default=None)
+        h, spread = motion_heading(self.heading, c.facing_away)
+        body = Body(cfg.half_width_m, cfg.half_length_m, cfg.block_margin_m + cfg.cell_m / 2)
+        hit = run_fault(cells, s.z, s.x, cmd.left, cmd.right, h, spread, travel, body,
+                        self.cfg.wheelbase_m)
         if hit is None:
             return ""
         what = "probe" if cmd.phase == Phase.PROBE else "reversed leg" if back else "drive"
@@ -1170,7 +1171,9 @@ class Servo:
         s, c = self.estimator.state, self.controller
         assert c is not None
         if s is not None:
-            self.heading.update(t, s.z, s.x, self._cmd.left, self._cmd.right)
+            g = self.geometry
+            self.heading.update(t, s.z, s.x, self._cmd.left, self._cmd.right, depth_noise_m(
+                s.z, self.estimator.sigma_px, g.focal_px, g.baseline_m))
         if not self._cmd.is_stop:
             self._still_since = None
         elif self._still_since is None:

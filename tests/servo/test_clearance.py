@@ -13,7 +13,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from host.servo.clearance import Heading, own_body
+from host.servo.clearance import Body, Heading, depth_noise_m, own_body, swept
 from host.servo.controller import (
     LINE_BLOCKED,
     PUSHED,
@@ -273,10 +273,46 @@ def test_the_heading_is_learnt_from_a_straight_run_and_forgotten_in_a_spin() -> 
     way it faces, not the way it went); kept standing; forgotten in a spin."""
     h, a = Heading(), math.radians(-32)
     for k in range(6):
-        h.update(0.07 * k, 1.8 - 0.01 * k * math.cos(a), 0.1 - 0.01 * k * math.sin(a), -300, -300)
+        h.update(0.07 * k, 1.8 - 0.01 * k * math.cos(a), 0.1 - 0.01 * k * math.sin(a), -300, -300,
+                 0.002)
     assert h.value is not None and abs(h.value - a) < 1e-6
-    assert h.update(0.5, 1.75, 0.13, 0, 0) == h.value
-    assert h.update(0.6, 1.75, 0.13, 300, -300) is None
+    assert h.update(0.5, 1.75, 0.13, 0, 0, 0.002) == h.value
+    assert h.update(0.6, 1.75, 0.13, 300, -300, 0.002) is None
+
+
+def test_the_headings_spread_follows_the_depth_noise_at_its_range() -> None:
+    """sigma_z = z^2 sigma_d / (f B): 3.4 cm a sighting at 2.95 m, 4 mm at 1 m (0.1 px, the
+    Minoru at 320 px). A 6 cm chord driven at 2.95 m gives no heading (its spread, 2 sigma
+    across the chord, is wider than max_spread); the same chord at 1 m gives one within 8
+    degrees; a 30 cm chord at 2.95 m gives one too. With the old fixed 5 mm of noise the
+    chord at 2.95 m was taken."""
+    def run(z0: float, length: float) -> Heading:
+        h = Heading()
+        noise = depth_noise_m(z0, 0.1, 426.0, 0.06)
+        for k in range(11):
+            h.update(0.05 * k, z0 + length * k / 10, 0.0, 300, 300, noise)
+        return h
+    assert abs(depth_noise_m(2.95, 0.1, 426.0, 0.06) - 0.034) < 0.001
+    assert run(2.95, 0.06).value is None
+    near = run(1.0, 0.06)
+    assert near.value is not None and abs(near.value) < 1e-9 and near.spread < math.radians(8)
+    far = run(2.95, 0.30)
+    assert far.value is not None and far.spread < far.max_spread
+
+
+def test_a_run_sweeps_the_bodys_rectangle_turned_by_its_heading() -> None:
+    """The body in a run is its 16 x 16 cm rectangle, grown by 3 cm, turned by the heading:
+    straight along the depth axis 10 cm right of centre it passes the end of a box's face at
+    x 0.23 (its side and margin reach 0.21); 13 cm right it does not (0.24). Toward a wall
+    at 3.19 m at 30 degrees, its corner (15 cm ahead of the centre, against 11 straight)
+    reaches the wall within 6 cm of travel; straight at the wall it would not."""
+    body = Body(0.08, 0.08, 0.03)
+    face = np.array([[1.80, 0.23], [1.80, 0.25], [1.80, 0.27]])
+    assert swept(face, 2.05, 0.10, math.pi, 0.3, body) is None
+    assert swept(face, 2.05, 0.13, math.pi, 0.3, body) is not None
+    wall = np.stack([np.full(41, 3.19), np.linspace(-0.4, 0.4, 41)], axis=1)
+    assert swept(wall, 3.0, 0.0, math.radians(30), 0.06, body) is not None
+    assert swept(wall, 3.0, 0.0, 0.0, 0.06, body) is None
 
 
 def test_the_trial_judge_names_the_object_that_was_hit() -> None:
