@@ -109,19 +109,22 @@ class StereoMatcher:
         self.range_policy = range_policy
 
     @classmethod
-    def create(cls, matcher: str = "sad", block_size: int = 9,
+    def create(cls, matcher: str = "sad", block_size: int | None = None,
                num_disparities: int | None = None, min_disparity: int = 0,
                range_policy: str | RangePolicy | None = None, **params: Any) -> StereoMatcher:
         """A matcher by name (one of MATCHERS) and MatcherParams fields (OpenCV's names:
-        block_size, num_disparities, uniqueness_ratio ...). num_disparities given: the range
-        min_disparity .. min_disparity + num_disparities - 1 px; else range_policy ("coarse"
-        by default, "depth:NEAR:FAR" needs focal_baseline in compute, "fixed:N") decides per
-        pair."""
+        block_size, num_disparities, uniqueness_ratio ...) over the matcher's measured
+        defaults, the ones `--matcher NAME` gives (MatcherParams.for_matcher; block_size None:
+        the matcher's own). num_disparities given: the range min_disparity ..
+        min_disparity + num_disparities - 1 px; else range_policy ("coarse" by default,
+        "depth:NEAR:FAR" needs focal_baseline in compute, "fixed:N") decides per pair."""
         if matcher not in MATCHERS:
             raise InputError(f"unknown matcher {matcher!r} (choose from {', '.join(MATCHERS)})")
         with _as_input_error():
-            p = MatcherParams.from_dict({"matcher": matcher, "block_size": block_size,
-                                         "min_disparity": min_disparity, **params})
+            given = {"min_disparity": min_disparity, **params}
+            if block_size is not None:
+                given["block_size"] = block_size
+            p = MatcherParams.from_dict(given, MatcherParams.for_matcher(matcher))
             if num_disparities is not None:
                 if range_policy is not None:
                     raise InputError("give num_disparities or range_policy, not both")

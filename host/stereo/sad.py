@@ -10,6 +10,9 @@ of rows per thread; a band sums its first window once and then only slides. With
 column sums are updated one tile of columns at a time and the window slides over that tile at
 once, so the sums it reads are still in L1. Sums are uint16 when the largest window cost fits
 (grey up to 15x15), else int32; the arithmetic wraps exactly because every true sum fits.
+The columns left of the full range (x < nd + half, where some candidates' right windows leave
+the image) slide and take their minimum in the same vector pass as the interior, the candidates
+outside masked, instead of one plain loop per candidate.
 """
 
 from __future__ import annotations
@@ -26,6 +29,10 @@ TILE_BYTES = 8192  # column sums updated per tile: well inside a 32 KiB L1 with 
 # known, LLVM makes each stretch one vector, where a loop of unknown length gets a 4-way
 # interleaved body of 128 lanes whose 8-lane and scalar remainder took every count below 128
 LANES = 32
+# The column sums' candidate loop runs over nd rounded up to a multiple of COL_LANES (two such
+# vectors): LLVM's main body takes 64 lanes at a time, so 48, 56 or 96 candidates ran part of
+# every column in the remainder loop (640 columns: 48 took 7.0-10.1 us a row, 64 5.3-8.0)
+COL_LANES = 64
 
 
 def lane_types(channels: int, size: int) -> tuple[type, type]:
@@ -163,9 +170,32 @@ def _interior(col, win, floor, idx, out, yi, x_from, x_to, half, dmin, nd, fit):
         out[yi, x] = dmin + nd - 1 - best - off
 
 
+@njit(cache=True, fastmath=True, inline="always")
+def _edge(col, win, floor, idx, efloor, eidx, out, yi, x_from, x_to, half, dmin, nd, fit):
+    """Outputs whose right windows leave the image for some candidates (kmin > 0): both window
+    columns inside, no uniqueness. As _interior, with the candidates below kmin lifted out by
+    efloor / eidx (a copy of floor / idx whose lanes below kmin say top / none; kmin falls by
+    one a column, so one lane is let in per column): the same winner as _argmin from kmin."""
+    kmin = nd - 1 - (x_from - half - dmin)
+    for k in range(idx.size):
+        masked = k < kmin
+        efloor[k] = floor[win.size] if masked else floor[k]
+        eidx[k] = idx[win.size] if masked else idx[k]
+    for x in range(x_from, x_to):
+        kmin = nd - 1 - (x - half - dmin)
+        efloor[kmin] = floor[kmin]
+        eidx[kmin] = idx[kmin]
+        best, m = _slide_lowest(win, efloor, eidx, col, x + half, x - half - 1)
+        off = 0.0
+        if fit != FIT_NONE and kmin < best < nd - 1:
+            off = fit_offset(np.float32(win[best - 1]), np.float32(m),
+                             np.float32(win[best + 1]), fit)
+        out[yi, x] = dmin + nd - 1 - best - off
+
+
 @njit(cache=True, fastmath=True)
-def _row_outputs(col, win, zero, floor, idx, rowcost, out, yi, x_from, x_to, x_start, half, w,
-                 dmin, nd, top, uniqueness, fit, want_right):
+def _row_outputs(col, win, zero, floor, idx, efloor, eidx, rowcost, out, yi, x_from, x_to,
+                 x_start, half, w, dmin, nd, top, uniqueness, fit, want_right):
     """Slide the window over outputs x in [x_from, x_to) of one row, writing out[yi, x]."""
     if x_from == x_start:
         win[:] = 0
@@ -174,10 +204,20 @@ def _row_outputs(col, win, zero, floor, idx, rowcost, out, yi, x_from, x_to, x_s
     # outputs that need none of the edge rules below
     fast_lo = max(x_from, half + 1, half + dmin + nd - 1)
     fast_hi = min(x_to, w - half)
+    # outputs left of those with some candidates' right windows outside (kmin > 0)
+    edge_lo = max(x_from, half + 1, half + dmin)
+    edge_hi = min(x_to, w - half, half + dmin + nd - 1)
     if uniqueness > 0.0 or want_right or fast_hi <= fast_lo:
         fast_lo = fast_hi = x_to
+    if uniqueness > 0.0 or want_right or edge_hi <= edge_lo:
+        edge_lo = edge_hi = x_to
     x = x_from
     while x < x_to:
+        if x == edge_lo:
+            _edge(col, win, floor, idx, efloor, eidx, out, yi, edge_lo, edge_hi, half, dmin,
+                  nd, fit)
+            x = edge_hi
+            continue
         if x == fast_lo:
             _interior(col, win, floor, idx, out, yi, fast_lo, fast_hi, half, dmin, nd, fit)
             x = fast_hi
@@ -242,37 +282,48 @@ def match_sad(left, right, dmin, nd, half, uniqueness, fit, want_right, clip, co
     base0 = pad - dmin - (nd - 1)
     cdt = col_proto.dtype
     wdt = win_proto.dtype
-    tile = max(2 * half + 2, TILE_BYTES // (nd * col_proto.itemsize))
-    ndp = -(-nd // LANES) * LANES  # the window's lanes; past nd they stay 0 and never win
+    ndp = -(-nd // LANES) * LANES  # the window's lanes; past nd they never win (floor, idx)
+    # the column sums' loop runs over ndc lanes (above LANES candidates, a multiple of
+    # COL_LANES): those past nd sum pixels right of the range, which the window never takes
+    ndc = nd if nd <= LANES else -(-nd // COL_LANES) * COL_LANES
+    tile = max(2 * half + 2, TILE_BYTES // (ndc * col_proto.itemsize))
+    short = base0 + w + ndc - 1 - right_p.shape[2]  # the last column's lanes past the view
+    if short > 0:  # room for the lanes past nd right of the padded right view
+        wider = np.zeros((nch, right_p.shape[1], right_p.shape[2] + short), dtype=np.uint8)
+        wider[:, :, :right_p.shape[2]] = right_p
+        right_p = wider
     nbands = max(1, min(rows, nbands))
     for band in prange(nbands):
         y0 = half + rows * band // nbands
         y1 = half + rows * (band + 1) // nbands
-        col = np.zeros((w, ndp), dtype=cdt)  # _cols_* update lanes 0 .. nd - 1 only
+        col = np.zeros((w, max(ndc, ndp)), dtype=cdt)
         win = np.zeros(ndp, dtype=wdt)
         zero = np.zeros(ndp, dtype=cdt)
         floor = np.zeros(ndp + 1, dtype=wdt)
         floor[nd:] = top
         idx = np.minimum(np.arange(ndp + 1), nd).astype(wdt)
+        efloor = floor.copy()
+        eidx = idx.copy()
         rowcost = np.full((w if want_right else 1, nd), top, dtype=wdt)
         for yy in range(y0 - half, y0 + half + 1):
-            _cols_add(col, left_p, right_p, yy, 0, w, base0, nd)
+            _cols_add(col, left_p, right_p, yy, 0, w, base0, ndc)
         for y in range(y0, y1):
             yi = y - ro  # image row
             if y == y0:
-                _row_outputs(col, win, zero, floor, idx, rowcost, disp_l, yi, x_start, x_end,
-                             x_start, half, w, dmin, nd, top, uniqueness, fit, want_right)
+                _row_outputs(col, win, zero, floor, idx, efloor, eidx, rowcost, disp_l, yi,
+                             x_start, x_end, x_start, half, w, dmin, nd, top, uniqueness, fit,
+                             want_right)
             else:
                 done = x_start
                 for tx0 in range(0, w, tile):
                     tx1 = min(w, tx0 + tile)
                     _cols_slide(col, left_p, right_p, y + half, y - half - 1, tx0, tx1, base0,
-                                nd)
+                                ndc)
                     upto = x_end if tx1 == w else min(x_end, tx1 - half)
                     if upto > done:
-                        _row_outputs(col, win, zero, floor, idx, rowcost, disp_l, yi, done, upto,
-                                     x_start, half, w, dmin, nd, top, uniqueness, fit,
-                                     want_right)
+                        _row_outputs(col, win, zero, floor, idx, efloor, eidx, rowcost,
+                                     disp_l, yi, done, upto, x_start, half, w, dmin, nd, top,
+                                     uniqueness, fit, want_right)
                         done = upto
             if want_right:
                 _right_row(rowcost, disp_r, yi, w, x_start, x_end, dmin, nd, top, fit)

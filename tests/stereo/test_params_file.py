@@ -69,3 +69,16 @@ def test_a_file_without_a_range_keeps_the_range_policy_in_the_api(tmp_path: Path
     path = _file(tmp_path, '[matcher]\nmatcher = "sgm"\nnum_disparities = 32\n')
     assert load_params_file(path).range_policy is None
     assert load_params_file(path).params.num_disparities == 32
+
+
+@pytest.mark.parametrize("matcher", ["sgm", "sad", "ncc", "opencv-sgbm"])
+def test_the_api_starts_from_the_defaults_the_command_line_gives(matcher: str) -> None:
+    """StereoMatcher.create("sgm") is `--matcher sgm`: window 1, 4 paths, LR, fill ... (it gave
+    the plain dataclass defaults, block_size 9 over sgm's window 1); what is given overrides."""
+    p = argparse.ArgumentParser()
+    add_matcher_options(p)
+    cli = params_from_args(p.parse_args(["--matcher", matcher]))
+    assert StereoMatcher.create(matcher).params == cli
+    cli = params_from_args(p.parse_args(["--matcher", matcher, "--block-size", "5",
+                                         "--num-disparities", "32"]))
+    assert StereoMatcher.create(matcher, block_size=5, num_disparities=32).params == cli
