@@ -28,9 +28,27 @@ def row_gains(grey: np.ndarray, reference: np.ndarray) -> np.ndarray:
     reference phase's left image, float32), smoothed over 5 rows."""
     step = max(1, grey.shape[1] // 80)  # 80 columns or so: the median of a row is robust
     ratio = grey[:, ::step].astype(np.float32) / np.maximum(reference[:, ::step], 8.0)
-    gains = np.median(ratio, axis=1).astype(np.float32)
+    gains = _row_medians(ratio).astype(np.float32)
     smooth: np.ndarray = cv2.medianBlur(gains.reshape(-1, 1), 5)
     return smooth.ravel()
+
+
+def _row_medians(a: np.ndarray) -> np.ndarray:
+    """np.median(a, axis=1) of a float array, exactly, from a sort of the rows (a quarter of
+    median's CPU on 240 rows of 80: its partition and checks cost more than the sort): the
+    middle element, or the two middle ones' mean in a's precision as np.mean takes it. A row
+    holding NaN goes to np.median (its median is NaN)."""
+    n = a.shape[1]
+    if not n or np.isnan(a).any():
+        median: np.ndarray = np.median(a, axis=1)
+        return median
+    s = np.sort(a, axis=1)
+    if n % 2:
+        middle: np.ndarray = s[:, n // 2]
+        return middle
+    out: np.ndarray = s[:, n // 2 - 1] + s[:, n // 2]
+    out /= 2
+    return out
 
 
 def _scaled(image: np.ndarray, gains: np.ndarray) -> np.ndarray:
