@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from host.servo.deflicker import _row_medians, row_gains
+from host.servo.deflicker import _row_medians, _spread_reaches, row_gains
 from host.sim.faults import Event, WorldFaults
 from host.sim.renderer import Flicker
 from host.sim.run import Setup, simulation
@@ -54,3 +54,19 @@ def test_row_medians_are_numpys_medians_exactly() -> None:
             want, got = np.median(a, axis=1), _row_medians(a)
             assert got.dtype == want.dtype
             assert np.array_equal(got, want, equal_nan=True)
+
+
+def test_the_spread_is_decided_as_by_numpys_percentiles() -> None:
+    """Flicker or not: the same decision as np.percentile's 5th to 95th spread against the
+    limit, for rows of gains spread round the limit (most within a thousandth of it)."""
+    rng = np.random.default_rng(4)
+    for n in range(3000):
+        m = int(rng.integers(1, 260))
+        g = (1 + rng.normal(0, rng.choice([0.01, 0.0152, 0.0155, 0.02]), m)).astype(np.float32)
+        if n % 4 == 0:
+            g = np.round(g, 2).astype(np.float32)
+        if n % 97 == 0:
+            g[0] = np.nan
+        lo, hi = np.percentile(g, [5, 95])
+        limit = float(hi - lo) + float(rng.choice([0.0, 1e-9, -1e-9, 1e-3, -1e-3, 0.02]))
+        assert _spread_reaches(g, limit) == bool(hi - lo >= limit)
