@@ -12,8 +12,13 @@ a before/after ratio is taken (run them alternately: the machine is shared). Wit
 --colour-camera runs each trial a second time, right after, with the simulated camera sending
 its colour images as a real Minoru does (the trials' camera renders them in grey, since the
 servo matches in grey: host.sim.run, Renderer's grey), and prints the two CPU times side by
-side and their ratio. Dev seeds only (1..8, 100..199; never 9 or 10..99, the lead's reported
-campaigns). Prints the load average with the figures."""
+side and their ratio. With --plain, --against DIR (another checkout, e.g. `git worktree add` or
+`git archive` of the commit before) loads that checkout's `host` too, in this same process
+(each version's modules swapped into sys.modules while it runs), and runs each trial with
+both, alternating which goes first: the CPU a trial of this code against that code's, their
+ratio, and whether the two gave the same trial records (exit 1 if not). Dev seeds only (1..8,
+100..199; never 9 or 10..99, the lead's reported campaigns). Prints the load average with the
+figures."""
 
 from __future__ import annotations
 
@@ -21,6 +26,7 @@ import argparse
 import collections
 import contextlib
 import os
+import sys
 import time
 from collections.abc import Callable, Iterator
 from typing import Any
@@ -40,13 +46,18 @@ def main() -> None:
     ap.add_argument("--colour-camera", action="store_true",
                     help="each trial again with the camera sending colour images (the "
                          "reference for the grey camera's ratio)")
+    ap.add_argument("--against", metavar="DIR",
+                    help="another checkout: each trial also with its code, alternating")
     a = ap.parse_args()
-    if a.colour_camera and not a.plain:
-        ap.error("--colour-camera goes with --plain (whole trials timed, alternating)")
+    if (a.colour_camera or a.against) and not a.plain:
+        ap.error("--colour-camera and --against go with --plain (whole trials timed, "
+                 "alternating)")
     if a.seed not in DEV_SEEDS:
         ap.error("dev seeds only: 1..8 and 100..199 (9 and 10..99 are held out for reported "
                  "figures)")
     one_thread()
+    if a.against:
+        raise SystemExit(_against(a.against, a.seed, a.trials))
     import host.camera.calibration as calibration
     import host.emulator.emulator as emulator
     import host.link.client as client
@@ -146,6 +157,93 @@ def _colour_camera(renderer: Any) -> Iterator[None]:
         yield
     finally:
         renderer.Renderer.__init__ = init
+
+
+def _host_modules() -> dict[str, Any]:
+    return {k: m for k, m in sys.modules.items() if k == "host" or k.startswith("host.")}
+
+
+@contextlib.contextmanager
+def _modules(mods: dict[str, Any]) -> Iterator[None]:
+    """One version's `host` modules in sys.modules meanwhile (its functions' late imports
+    find their own version's)."""
+    saved = _host_modules()
+    for k in saved:
+        del sys.modules[k]
+    sys.modules.update(mods)
+    try:
+        yield
+    finally:
+        for k in _host_modules():
+            del sys.modules[k]
+        sys.modules.update(saved)
+
+
+def _version(path: str | None) -> tuple[dict[str, Any], Callable[..., Any]]:
+    """The `host` modules of the checkout at path (None: this one, as PYTHONPATH gives it),
+    imported afresh, and a run of one trial with them (calibrations and a first trial done)."""
+    with _modules({}):
+        if path:
+            sys.path.insert(0, path)
+        try:
+            from host.sim.run import _calibration
+            from host.sim.trials import run_trial, trial_setup
+            from host.stereo.params import MatcherParams
+        finally:
+            if path:
+                sys.path.remove(path)
+        mods = _host_modules()
+    params = MatcherParams.for_matcher(MatcherParams.matcher).validate()
+
+    def run(seed: int, i: int, warm: bool = False) -> Any:
+        with _modules(mods):
+            if warm:
+                s = trial_setup(seed, i, (320, 240), params, False)
+                _calibration((320, 240), s.faults.camera.distortion, s.calib_seed)
+                return None
+            return run_trial((seed, i, (320, 240), params, False))
+    return mods, run
+
+
+def _record(t: Any) -> str:
+    """A trial's record as the campaign's JSON writes it (the same dataclass fields)."""
+    import dataclasses
+    import json
+    return json.dumps(dataclasses.asdict(t), sort_keys=True, default=str)
+
+
+def _against(other: str, seed: int, trials: list[int]) -> int:
+    """This checkout's trials against `other`'s, alternating in this process."""
+    _, new = _version(None)
+    old_mods, old = _version(os.path.abspath(other))
+    print(f"this code: {sys.modules['host'].__file__}; against: "
+          f"{old_mods['host'].__file__}")
+    for i in trials:
+        new(seed, i, warm=True)
+        old(seed, i, warm=True)
+    new(seed, trials[0])
+    old(seed, trials[0])
+    load = os.getloadavg()
+    cpu = {"new": 0.0, "old": 0.0}
+    differ = []
+    for n, i in enumerate(trials):
+        got = {}
+        for name in (("new", "old") if n % 2 == 0 else ("old", "new")):
+            t0 = time.process_time()
+            got[name] = (new if name == "new" else old)(seed, i)
+            cpu[name] += time.process_time() - t0
+        same = _record(got["new"]) == _record(got["old"])
+        if not same:
+            differ.append(i)
+        print(f"trial {i}: {got['new'].outcome:8s} new/old so far "
+              f"{cpu['new'] / cpu['old']:.3f}{'' if same else '  RECORDS DIFFER'}", flush=True)
+    print(f"load {load[0]:.1f}/{load[1]:.1f}/{load[2]:.1f} -> "
+          f"{'/'.join(f'{v:.1f}' for v in os.getloadavg())}; seed {seed}, {len(trials)} "
+          f"trials: this code {cpu['new']:.2f} s CPU ({cpu['new'] / len(trials):.3f} a trial), "
+          f"{other} {cpu['old']:.2f} s ({cpu['old'] / len(trials):.3f}): "
+          f"{cpu['new'] / cpu['old']:.3f}x; records "
+          f"{'identical' if not differ else 'differ in trials ' + str(differ)}")
+    return 1 if differ else 0
 
 
 def _untimed(owner: object, name: str, label: str) -> None:

@@ -428,16 +428,26 @@ def lane_obstacle(disp: np.ndarray, geometry: Geometry, depth_m: float, lateral_
     """
     g = geometry
     fb = g.focal_px * g.baseline_m
+    # only the box round disp's valid pixels (match_window's box): the same pixels, in the same
+    # order, at a fraction of the whole map's CPU
+    whole, finite = disp, np.isfinite(disp)
+    rows, cols = np.flatnonzero(finite.any(1)), np.flatnonzero(finite.any(0))
+    if not rows.size:
+        return None
+    r0, c0 = int(rows[0]), int(cols[0])
+    disp = disp[r0:int(rows[-1]) + 1, c0:int(cols[-1]) + 1]
     with np.errstate(invalid="ignore"):
         ok = np.isfinite(disp) & (disp > 0.5)
         robot = (np.abs(disp - fb / depth_m) < 1.5).astype(np.uint8)
-    if robot_px and robot.any():
+    if robot_px and robot.any():  # nothing of the robot's disparity lies outside the box
         k = 2 * robot_px + 1
         ok &= cv2.dilate(robot, np.ones((k, k), np.uint8)) == 0
     vs, us = np.nonzero(ok)
     if vs.size == 0:
         return None
     d = disp[vs, us].astype(np.float64)
+    box_vs, box_us = vs, us
+    vs, us = vs + r0, us + c0
     z = fb / d
     x = g.baseline_m * (us - g.cx) / d
     y = camera_height_m - g.baseline_m * (vs - g.cy) / d
@@ -451,8 +461,15 @@ def lane_obstacle(disp: np.ndarray, geometry: Geometry, depth_m: float, lateral_
     if int(keep.sum()) < 25:
         return None
     mask = np.zeros(disp.shape, np.uint8)
-    mask[vs[keep], us[keep]] = 1
+    mask[box_vs[keep], box_us[keep]] = 1
     _, labels, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
+    areas = stats[1:, cv2.CC_STAT_AREA]
+    if np.count_nonzero(areas == areas.max()) > 1:
+        # patches of the same size: the first in the whole map's numbering is the one taken
+        on_whole = np.zeros(whole.shape, np.uint8)
+        on_whole[vs[keep], us[keep]] = 1
+        _, labels, stats, _ = cv2.connectedComponentsWithStats(on_whole, connectivity=8)
+        disp = whole
     best = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
     zm = float(np.median(fb / disp[labels == best]))
     area = int(stats[best, cv2.CC_STAT_AREA])

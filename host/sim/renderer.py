@@ -157,6 +157,9 @@ class Renderer:
         self._row0 = 0  # rows of the canvas above the view's first (a pitched rig sees them)
         self.flicker: Flicker | None = None
         self._touched: list[tuple[int, int, int, int]] = []  # rows, columns drawn this view
+        # the last view as the bare scene's image (never written to) and the rows, columns
+        # y0, y1, x0, x1 where it differs from it (None: nowhere); None: a whole new image
+        self.changed: tuple[np.ndarray, tuple[int, int, int, int] | None] | None = None
         self._bare_key: tuple[object, ...] | None = None  # the layout _bare_images are of
         self._bare_images: dict[tuple[object, ...], np.ndarray] = {}
         self._lens = [lens_maps(world, k1) for k1 in camera.distortion]
@@ -366,6 +369,7 @@ class Renderer:
                 blur = blur_px if thing is world.robot else (0.0, 0.0)
                 self._draw_robot(img, disp, float(side), blur, thing)
         k = self._noise_field(side)
+        self.changed = None
         if not self.pitch_deg and self.flicker is None and self._lens[side] is not None:
             return self._through_lens(img, side, k), disp
         if not self.pitch_deg and self.flicker is None and self._lens[side] is None:
@@ -373,10 +377,12 @@ class Renderer:
             # pixels come from the sensor's image of the bare scene with this noise field, and
             # only the pixels drawn over go through the sensor again
             out = self._bare(side, k).copy()
+            self.changed = (self._bare(side, k), None)
             if self._touched:  # one rectangle round them all: the drawings overlap
                 r0, r1, c0, c1 = (f(t[i] for t in self._touched)
                                   for i, f in enumerate((min, max, min, max)))
                 out[r0:r1, c0:c1] = self._sensor(img[r0:r1, c0:c1], side, k, (r0, r1, c0, c1))
+                self.changed = (self._bare(side, k), (r0, r1, c0, c1))
             return out, disp
         if self.pitch_deg:  # the canvas's rows seen through the pitched rig
             hom = rotation_homography(world, self.pitch_deg) @ np.array(
@@ -460,6 +466,7 @@ class Renderer:
         makes each pixel from its map's entry and the 2x2 source pixels there alone, so only
         the pixels whose source meets the rectangle drawn over are remapped again."""
         out = self._bare(side, k).copy()
+        self.changed = (self._bare(side, k), None)
         if not self._touched:
             return out
         r0, r1, c0, c1 = (f(t[i] for t in self._touched)
@@ -479,6 +486,7 @@ class Renderer:
         if box is None:
             return out
         y0, y1, x0, x1 = box
+        self.changed = (self._bare(side, k), box)
         # the drawn rectangle goes into the bare scene's image for the remap and is taken out
         # again: the same source as a copy with the rectangle in it, without copying the rest
         kept = src[r0:r1, c0:c1].copy()

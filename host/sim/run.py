@@ -11,7 +11,6 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
-from host.camera.calibration import Rectifier
 from host.emulator.emulator import Emulator
 from host.emulator.lockstep import LockstepLine
 from host.link.client import SERVO_DRIVE_BUDGET_S, RobotLink
@@ -20,6 +19,7 @@ from host.servo.loop import Servo
 from host.servo_run import Rules, run_servo
 from host.sim.chessboard import calibrate_camera
 from host.sim.faults import CameraFaults, WorldFaults
+from host.sim.rectify import SimRectifier
 from host.sim.renderer import Renderer
 from host.sim.source import SimSource
 from host.sim.world import Box, World
@@ -96,7 +96,7 @@ def simulation(setup: Setup = Setup(), reference: bool = True) -> Iterator[SimRu
         if any(faults.camera.distortion):  # rectify as a user would: with a calibration
             seed = setup.seed if setup.calib_seed is None else setup.calib_seed
             calib = _calibration(setup.size, faults.camera.distortion, seed)
-            source.rectify = Rectifier(calib)
+            source.rectify = SimRectifier(calib, source)  # the Rectifier's images
             geometry = calib.geometry
         servo = Servo(source, link, setup.params, geometry, setup.control, clock=source.clock)
         run = SimRun(world, emulator, source, servo, link)

@@ -11,6 +11,7 @@ import numpy as np
 from host.camera.source import StereoFrame, StereoSource
 from host.emulator.board import Board
 from host.sim.faults import Event
+from host.sim.rectify import Changed
 from host.sim.renderer import Flicker, Renderer
 from host.sim.world import Box, Person, Robot, World
 
@@ -58,6 +59,7 @@ class SimSource(StereoSource):
         self._walker: Event | None = None
         self._freeze: Event | None = None
         self._held: list[tuple[np.ndarray, float] | None] = [None, None]  # last image, stamp
+        self._made: list[tuple[np.ndarray, Changed | None] | None] = [None, None]
         self.log: list[str] = []  # what happened in the scene, with times
 
     @property
@@ -243,4 +245,10 @@ class SimSource(StereoSource):
                 vel[1] * self.renderer.camera.exposure_ms / 1000)
         image, _ = self.renderer.view(side, with_robot, blur, t_s=began)
         self._held[side] = (image, stamp)
+        self._made[side] = (image, self.renderer.changed)
         return image, stamp
+
+    def made(self, side: int) -> tuple[np.ndarray, Changed | None] | None:
+        """The side's last rendered image and how the renderer made it (Renderer.changed:
+        host.sim.rectify rectifies it again only where it differs from the bare scene)."""
+        return self._made[side]

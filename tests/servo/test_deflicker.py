@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from host.servo.deflicker import row_gains
+from host.servo.deflicker import _row_medians, _spread_reaches, row_gains
 from host.sim.faults import Event, WorldFaults
 from host.sim.renderer import Flicker
 from host.sim.run import Setup, simulation
@@ -36,3 +36,37 @@ def test_the_marker_is_seen_through_flicker_at_its_own_disparity() -> None:
         seen = [r for r in rows if math.isfinite(r.depth_m)]
         assert len(seen) >= 0.9 * len(rows)
         assert all(abs(r.depth_m - r.truth_depth_m) < 0.02 for r in seen)
+
+
+def test_row_medians_are_numpys_medians_exactly() -> None:
+    """The sorted rows' medians are np.median's, bit for bit: odd and even widths, ties,
+    float32 and float64, a row holding NaN."""
+
+    rng = np.random.default_rng(3)
+    for n in range(60):
+        h, w = int(rng.integers(1, 250)), int(rng.integers(1, 90))
+        for dtype in (np.float32, np.float64):
+            a = (rng.integers(0, 256, (h, w)) / rng.uniform(8, 255, (h, w))).astype(dtype)
+            if n % 3 == 0:
+                a = np.round(a, 1).astype(dtype)  # ties
+            if n % 5 == 0:
+                a[h // 2, 0] = np.nan
+            want, got = np.median(a, axis=1), _row_medians(a)
+            assert got.dtype == want.dtype
+            assert np.array_equal(got, want, equal_nan=True)
+
+
+def test_the_spread_is_decided_as_by_numpys_percentiles() -> None:
+    """Flicker or not: the same decision as np.percentile's 5th to 95th spread against the
+    limit, for rows of gains spread round the limit (most within a thousandth of it)."""
+    rng = np.random.default_rng(4)
+    for n in range(3000):
+        m = int(rng.integers(1, 260))
+        g = (1 + rng.normal(0, rng.choice([0.01, 0.0152, 0.0155, 0.02]), m)).astype(np.float32)
+        if n % 4 == 0:
+            g = np.round(g, 2).astype(np.float32)
+        if n % 97 == 0:
+            g[0] = np.nan
+        lo, hi = np.percentile(g, [5, 95])
+        limit = float(hi - lo) + float(rng.choice([0.0, 1e-9, -1e-9, 1e-3, -1e-3, 0.02]))
+        assert _spread_reaches(g, limit) == bool(hi - lo >= limit)
