@@ -10,7 +10,7 @@ from typing import Any
 
 import host
 from host.errors import describe
-from host.signals import signals_interrupt
+from host.signals import interrupt_ends_at_once, signals_interrupt
 
 # each command, in --help's order, with its line of help; its arguments and run come from
 # host.commands.NAME (add_arguments), imported only when that command runs or the whole parser
@@ -86,7 +86,7 @@ class _Parser(argparse.ArgumentParser):
 
 def build_parser(prog: str = "host", only: str | None = None) -> argparse.ArgumentParser:
     """The whole parser, or with only: every command listed but only that one's module
-    imported and its arguments added (the others parse nothing: main picks only from argv)."""
+    imported and its arguments added (none for ""; main picks only from argv)."""
     parser = _Parser(
         prog=prog, description="stereo-servo host: stereo matching, tuning and the robot servo")
     parser.add_argument("--version", action="version", version=f"stereo-servo {host.__version__}")
@@ -124,7 +124,8 @@ def main(argv: list[str] | None = None) -> int:
     Ctrl-C with status 128+n; --debug shows the traceback instead."""
     prog = "stereo-servo" if Path(sys.argv[0]).name == "stereo-servo" else "host"
     argv = sys.argv[1:] if argv is None else argv
-    args = build_parser(prog, only=command_named(argv) or "").parse_args(argv)
+    with interrupt_ends_at_once(f"{prog}: interrupted"):  # the command's module loads here
+        args = build_parser(prog, only=command_named(argv) or "").parse_args(argv)
     try:
         with signals_interrupt():
             return int(args.run(args))
