@@ -3,17 +3,31 @@
 from __future__ import annotations
 
 import argparse
+import importlib
 import sys
 from pathlib import Path
 from typing import Any
 
 import host
-from host.commands import bag, calibrate, cameras, capture, disparity, emulate, servo, tune, view
-from host.commands import eval as eval_cmd
 from host.errors import describe
-from host.signals import signals_interrupt
+from host.signals import interrupt_ends_at_once, signals_interrupt
 
-COMMANDS = [eval_cmd, disparity, tune, cameras, capture, calibrate, servo, emulate, view, bag]
+# each command, in --help's order, with its line of help; its arguments and run come from
+# host.commands.NAME (add_arguments), imported only when that command runs or the whole parser
+# is built: `host --version` and `host --help` load none of the libraries (numba, OpenCV)
+COMMANDS = {
+    "eval": "score a matcher against ground truth",
+    "disparity": "compute a disparity map from a rectified pair",
+    "tune": "tune the matcher's parameters (against ground truth, or self-supervised on a "
+            "camera's frames)",
+    "cameras": "list stereo cameras and the --camera that opens each",
+    "capture": "save stereo image pairs from the camera",
+    "calibrate": "calibrate and rectify the stereo camera",
+    "servo": "servo the robot to the nearest object's depth",
+    "emulate": "run the robot's firmware on a pseudo-terminal",
+    "view": "look at the stereo camera live in a browser (no robot)",
+    "bag": "what a recording holds; repair one a killed run cut off",
+}
 
 
 # one or two examples per command (a command module may define EXAMPLES itself instead)
@@ -70,7 +84,9 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
-def build_parser(prog: str = "host") -> argparse.ArgumentParser:
+def build_parser(prog: str = "host", only: str | None = None) -> argparse.ArgumentParser:
+    """The whole parser, or with only: every command listed but only that one's module
+    imported and its arguments added (none for ""; main picks only from argv)."""
     parser = _Parser(
         prog=prog, description="stereo-servo host: stereo matching, tuning and the robot servo")
     parser.add_argument("--version", action="version", version=f"stereo-servo {host.__version__}")
@@ -78,12 +94,20 @@ def build_parser(prog: str = "host") -> argparse.ArgumentParser:
                         help="show the traceback of an error instead of one line")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND",
                                 parser_class=_Parser)
-    for command in COMMANDS:
-        before = set(sub.choices)
-        command.add_parser(sub)
-        for name in set(sub.choices) - before:  # a command module may keep its own EXAMPLES
-            _finish(name, sub.choices[name], getattr(command, "EXAMPLES", EXAMPLES.get(name)))
+    for name, line in COMMANDS.items():
+        p = sub.add_parser(name, help=line)
+        if only in (None, name):
+            command = importlib.import_module(f"host.commands.{name}")
+            command.add_arguments(p)  # a command module may keep its own EXAMPLES
+            _finish(name, p, getattr(command, "EXAMPLES", EXAMPLES.get(name)))
     return parser
+
+
+def command_named(argv: list[str]) -> str | None:
+    """The command argv names: its first word not an option (host's own options take no
+    value), if it is a command."""
+    word = next((a for a in argv if not a.startswith("-")), None)
+    return word if word in COMMANDS else None
 
 
 def _finish(name: str, p: argparse.ArgumentParser, examples: list[str] | None) -> None:
@@ -99,7 +123,9 @@ def main(argv: list[str] | None = None) -> int:
     data) becomes one line on stderr and exit status 2; SIGINT, SIGTERM and SIGHUP end it like
     Ctrl-C with status 128+n; --debug shows the traceback instead."""
     prog = "stereo-servo" if Path(sys.argv[0]).name == "stereo-servo" else "host"
-    args = build_parser(prog).parse_args(argv)
+    argv = sys.argv[1:] if argv is None else argv
+    with interrupt_ends_at_once(f"{prog}: interrupted"):  # the command's module loads here
+        args = build_parser(prog, only=command_named(argv) or "").parse_args(argv)
     try:
         with signals_interrupt():
             return int(args.run(args))

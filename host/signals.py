@@ -5,6 +5,7 @@ keeps."""
 from __future__ import annotations
 
 import contextlib
+import os
 import signal
 import sys
 import threading
@@ -59,3 +60,20 @@ def signals_held(signums: tuple[int, ...] = HELD) -> Iterator[None]:
         yield
     if noted and sys.exc_info()[0] is None:
         raise KeyboardInterrupt if noted[0] == signal.SIGINT else Interrupted(noted[0])
+
+
+@contextlib.contextmanager
+def interrupt_ends_at_once(line: str) -> Iterator[None]:
+    """Inside the block (the libraries loading, before a command runs: nothing to clean up)
+    Ctrl-C writes line to stderr and ends the process at once with status 130. The usual
+    KeyboardInterrupt is not safe there: raised inside a C extension's import (numpy's
+    PyCapsule_Import of datetime) it comes out as an ImportError, numpy's page-long "bad
+    install" message and status 1."""
+
+    def handler(_signum: int, _frame: object) -> None:
+        sys.stderr.write(line + "\n")
+        sys.stderr.flush()
+        os._exit(128 + signal.SIGINT)
+
+    with _handling((signal.SIGINT,), handler):
+        yield

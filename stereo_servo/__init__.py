@@ -23,7 +23,7 @@ def shadowing() -> str | None:
 
 def main() -> int:
     """Run the CLI (host.cli.main), or one line and exit status 2 when host is shadowed; Ctrl-C
-    while the libraries load (before the CLI handles it) is one line and 130 too."""
+    while host.cli imports (before it handles Ctrl-C itself) is one line and 130 too."""
     name = Path(sys.argv[0]).name if Path(sys.argv[0]).name in NAMES else "stereo-servo"
     problem = shadowing()
     if problem:

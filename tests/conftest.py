@@ -92,6 +92,7 @@ SLOW_FILES = {
     "tests/link/test_emulated_serial.py": "faulty emulated lines in real time",
     "tests/servo/test_loop_rate.py": "simulated servo runs",
     "tests/test_cli_link.py": "host servo runs on faulty lines",
+    "tests/sim/test_knock_acquire.py": "a closed-loop run knocked during the probe",
     "tests/record": "recorded simulated runs",
     "tests/packaging": "builds and installs the package",
 }
@@ -130,6 +131,14 @@ SLOW_TESTS = {
         "a fresh interpreter loading numba and matching 640x480 many times",
     "tests/tuning/test_tune_cli.py::test_parallel_workers_give_the_same_result_as_one_process":
         "worker processes that each load the matcher",
+    "tests/sim/test_recover_events.py::test_a_knock_after_a_nearer_object_became_the_target_is_re_referenced":
+        "a closed-loop run",
+    "tests/test_cli_view_sim.py::test_view_shows_the_simulated_world":
+        "host view serving the simulated world",
+    "tests/view/test_view_command.py::test_view_shows_a_recording_without_stop":
+        "host view serving a replay",
+    "tests/tuning/test_progress.py::test_the_bar_shows_on_a_terminal":
+        "host tune on a terminal",
 }
 
 
@@ -138,6 +147,16 @@ def _is_slow(rel: str, name: str) -> bool:
         return True
     node = f"{rel}::{name}"
     return node in SLOW_TESTS or node.split("[")[0] in SLOW_TESTS
+
+
+def pytest_ignore_collect(collection_path: Path, config) -> bool | None:
+    """The fast tier (-m "not slow", exactly) does not even import the SLOW_FILES: their
+    imports (scipy.stats, Ray, rosbags, playwright) cost each worker ~3 s of CPU, for tests
+    it then deselects. Any other -m collects them and marks their tests slow as before."""
+    if " ".join(config.getoption("markexpr").split()) != "not slow":
+        return None
+    rel = collection_path.resolve().relative_to(ROOT).as_posix()
+    return True if rel in SLOW_FILES else None
 
 
 def pytest_collection_modifyitems(config, items) -> None:

@@ -14,8 +14,7 @@ EXAMPLES = ["host bag run.mcap                     # topics, types, counts, dura
             "host bag killed.mcap --repair fixed.mcap"]
 
 
-def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    p = sub.add_parser("bag", help="what a recording holds; repair one a killed run cut off")
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("file", type=Path, metavar="FILE.mcap", help="a recording (--record)")
     p.add_argument("--repair", type=Path, metavar="OUT.mcap",
                    help="write the file's complete messages to OUT.mcap, closed with a summary "

@@ -17,8 +17,7 @@ from host.files import check_folder, check_output, write_image_atomic
 from host.stereo.scenes import read_image
 
 
-def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    p = sub.add_parser("calibrate", help="calibrate and rectify the stereo camera")
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("folder", type=Path, help="left_*/right_* chessboard pairs")
     p.add_argument("--board", default="9x6", help="inner corners, columns x rows")
     p.add_argument("--square", type=POSITIVE, default=25.0, help="square size (mm)")

@@ -9,8 +9,7 @@ from host.camera.discovery import SYSFS, discover
 from host.errors import HostError
 
 
-def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    p = sub.add_parser("cameras", help="list stereo cameras and the --camera that opens each")
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--sysfs", type=Path, default=SYSFS, help="sysfs root to read (default /sys)")
     p.set_defaults(run=run)
 

@@ -16,8 +16,7 @@ from host.files import check_folder, write_image_atomic
 from host.record import add_record_options, check_record, recording
 
 
-def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    p = sub.add_parser("capture", help="save stereo image pairs from the camera")
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--count", type=COUNT, default=20, help="pairs to save")
     p.add_argument("--interval", type=NON_NEGATIVE, default=2.0, metavar="S",
                    help="seconds between saved pairs (time to move the chessboard)")

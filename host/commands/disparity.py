@@ -18,8 +18,7 @@ from host.stereo.picture import picture
 from host.stereo.scenes import read_image
 
 
-def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    p = sub.add_parser("disparity", help="compute a disparity map from a rectified pair")
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("left", type=Path, help="left image of a rectified pair")
     p.add_argument("right", type=Path, help="right image, same size and kind")
     p.add_argument("-o", "--out", type=Path, required=True,

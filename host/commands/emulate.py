@@ -20,8 +20,7 @@ FLASH_DEFAULT = Path("uno-flash.bin")
 RESET_LINES_PER_S = 3  # an erased chip resets ~60 times a second: say so once, not 60 times
 
 
-def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    p = sub.add_parser("emulate", help="run the robot's firmware on a pseudo-terminal")
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--simavr", action="store_true",
                    help="run the real AVR binary in simavr instead of the natively built core")
     p.add_argument("--uno", action="store_true",

@@ -36,8 +36,7 @@ from host.stereo.picture import picture
 from host.stereo.scenes import Scene, load_scenes
 
 
-def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    p = sub.add_parser("eval", help="score a matcher against ground truth")
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("scenes", nargs="*", type=Path, metavar="SCENE_DIR",
                    help="scene folders, or folders of them (default: the embedded Motorcycle "
                         "pair)")

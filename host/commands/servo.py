@@ -48,8 +48,7 @@ if TYPE_CHECKING:
 UNO_FLASH = Path("uno-flash.bin")  # --robot uno's flash file when --flash is not given
 
 
-def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    p = sub.add_parser("servo", help="servo the robot to the nearest object's depth")
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--sim", action="store_true",
                    help="simulated camera and world with the emulator on a pty")
     p.add_argument("--port", help="serial port of the robot, or 'emulator'")

@@ -45,9 +45,7 @@ DEFAULT_ITERATIONS = {"paper": 20, "guided": 20, "qlearning": 300, "random": 60,
                       "tpe": 60}
 
 
-def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    p = sub.add_parser("tune", help="tune the matcher's parameters (against ground truth, or "
-                                    "self-supervised on a camera's frames)")
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("scenes", nargs="*", type=Path, metavar="SCENE_DIR",
                    help="scenes with ground truth (default: the embedded Motorcycle pair)")
     p.add_argument("--objective", choices=("gt", "self"), default="gt",

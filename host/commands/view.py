@@ -91,8 +91,7 @@ def open_view(address: str | None, servo: Servo | None = None, wait: bool = Fals
         feed.close()
 
 
-def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    p = sub.add_parser("view", help="look at the stereo camera live in a browser (no robot)")
+def add_arguments(p: argparse.ArgumentParser) -> None:
     add_view_option(p, default="127.0.0.1:0")
     p.add_argument("--duration", type=POSITIVE, metavar="S", help="stop after S seconds")
     add_camera_options(p)

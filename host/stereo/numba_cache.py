@@ -3,10 +3,48 @@ importing host.stereo (every process that compiles one of our kernels imports it
 
 from __future__ import annotations
 
-import fcntl
+import functools
 import os
-from collections.abc import Callable
-from typing import Any
+import sys
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from typing import IO, Any
+
+if sys.platform == "win32":
+    import msvcrt
+
+    def _lock(f: IO[str]) -> None:
+        f.seek(0)  # msvcrt locks bytes from the file's position: byte 0 of the lock file
+        while True:  # LK_LOCK gives up after 10 tries a second apart; a compile can take longer
+            try:
+                msvcrt.locking(f.fileno(), msvcrt.LK_LOCK, 1)
+                return
+            except OSError:
+                continue
+
+    def _unlock(f: IO[str]) -> None:
+        f.seek(0)
+        msvcrt.locking(f.fileno(), msvcrt.LK_UNLCK, 1)
+else:
+    import fcntl
+
+    def _lock(f: IO[str]) -> None:
+        fcntl.flock(f, fcntl.LOCK_EX)
+
+    def _unlock(f: IO[str]) -> None:
+        fcntl.flock(f, fcntl.LOCK_UN)
+
+
+@contextmanager
+def exclusive(path: str) -> Iterator[None]:
+    """An exclusive lock between processes on the file at path (created if missing), held for
+    the with block: flock where there is fcntl (Linux, macOS), msvcrt.locking on Windows."""
+    with open(path, "a") as f:
+        _lock(f)
+        try:
+            yield
+        finally:
+            _unlock(f)
 
 
 def lock_cache_files() -> None:
@@ -24,10 +62,10 @@ def lock_cache_files() -> None:
         return
 
     def locked(fn: Callable[..., Any]) -> Callable[..., Any]:
+        @functools.wraps(fn)
         def run(self: Any, *args: Any) -> Any:
             os.makedirs(self._cache_path, exist_ok=True)
-            with open(self._index_path + ".lock", "a") as f:
-                fcntl.flock(f, fcntl.LOCK_EX)
+            with exclusive(self._index_path + ".lock"):
                 return fn(self, *args)
         return run
 
