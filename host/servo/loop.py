@@ -11,7 +11,8 @@
                      confirms -> depth (m) -> Controller -> SET_DRIVE or STOP over the link;
                      the Estimator also checks that the depth moves the way the robot is driven
     every remeasure_s the target is measured again outside the robot's own image region (on a
-    whole map matched a band of rows per frame, StripMap).
+    whole map matched a band of rows per frame, StripMap); a depth older than target_age_s (a
+    turn, a search, a wait skip them) is measured again, the robot standing, before it drives.
 
 Each piece is a state machine of its own (FrameTiming, Estimator, Acquisition, TargetTracker,
 Controller, Recovery, Progress); step() composes them, and each step has one Phase (phase.py).
@@ -144,6 +145,10 @@ class ServoConfig:
     max_mismatch_px: float = 1.5  # block matching against the marker's centres
     cut_mismatch_px: float = 0.35  # the same where the two views' discs differ (cut_views)
     remeasure_s: float = 1.0
+    target_age_s: float = 2.0  # the target's depth older than this (no re-measure: a turn, a
+    # search skip them; driving, one comes every remeasure_s plus a map's frames) is measured
+    # again before the robot drives on it (TargetTracker.aged), re-measures back to back
+    remeasure_stand_s: float = 4.0  # standing this long for it without one: the run ends
     robot_half_width_m: float = 0.12  # the image region left out of the re-measure
     robot_below_marker_m: float = 0.22
     lane_margin_m: float = 0.05  # watched beyond the stopping distance
@@ -249,6 +254,8 @@ class Servo:
         self.flips = 0  # heading corrections by the motion check
         self._strips: StripMap | None = None  # the re-measure's map, a band per frame
         self._remeasure_t: float | None = None
+        self._measured_t: float | None = None  # the target's depth last measured (frame time)
+        self._stand_since: float | None = None  # standing for a re-measure since
         self._cmd = Command(0, 0, Phase.WAIT, None)  # the command in force
         self._statics: list[tuple[float, float, float]] = []  # where non-moving look-alikes
         # stand: (u, v) px in the left image, depth (m)
@@ -472,7 +479,7 @@ class Servo:
         it was last seen (it stops when the marker is lost); never seen, or spinning: skip."""
         assert self._strips is not None and self.controller is not None
         due = self._remeasure_t is None or frame.t_left - self._remeasure_t >= \
-            self.cfg.remeasure_s
+            self.cfg.remeasure_s or not self.tracker_confirmed
         if due:
             self._remeasure_t = frame.t_left
         if not (due or self._strips.busy):
@@ -511,6 +518,8 @@ class Servo:
         before = self.tracker.target
         target = self.tracker.update(clean, lambda t: views_agree(
             frame.left, frame.right, t.bbox, t.disparity))
+        if self.tracker.measured:
+            self._measured_t = frame.t_left
         if self.tracker.stop_reason:
             if self._back_to_target(clean, frame):  # a nearer object that came and went
                 return
@@ -521,6 +530,37 @@ class Servo:
                               f"retargeting")
             self.controller.keep_out = self._extent(object_extent(clean, target))
         self.controller.target_m = self.geometry.depth_m(target.disparity)
+
+    @property
+    def tracker_confirmed(self) -> bool:
+        """The target's depth is not an aged one waiting for a re-measure."""
+        return self.tracker is None or self.tracker.confirmed
+
+    def _measured_first(self, t: float, cmd: Command, invalid: str) -> tuple[Command, str]:
+        """A drive on a target depth older than target_age_s: the robot stands (phase
+        "wait") while the re-measure runs back to back, until the tracker has confirmed or
+        replaced the depth (TargetTracker.aged); standing remeasure_stand_s without that, the
+        run ends, named. The controller learns that it stood (its creep floor must not rise)."""
+        assert self.tracker is not None and self.controller is not None
+        if self._measured_t is None:
+            self._measured_t = t  # the reference has just measured it
+        age = t - self._measured_t
+        if age > self.cfg.target_age_s:
+            self.tracker.aged()
+        if self.tracker.confirmed or cmd.is_stop or cmd.phase not in (Phase.DRIVE, Phase.CREEP):
+            self._stand_since = None
+            return cmd, invalid
+        if self._stand_since is None:
+            self._stand_since = t
+        if t - self._stand_since > self.cfg.remeasure_stand_s:
+            self.stop_reason = self.stop_reason or (
+                f"the target's depth could not be measured again in "
+                f"{self.cfg.remeasure_stand_s:.0f} s standing (last measured {age:.1f} s ago)")
+            self.controller.phase = Phase.STOP
+            return Command(0, 0, Phase.STOP, cmd.error_m), invalid
+        self.controller.phase = Phase.WAIT
+        return Command(0, 0, Phase.WAIT, cmd.error_m), invalid or (
+            f"re-measuring the target: its depth is {age:.1f} s old")
 
     # ---------------------------------------------------------------------- the lane
 
@@ -796,6 +836,7 @@ class Servo:
                 self.recovery.update(t, True)  # found again through the gate, from scratch
                 self._reacquire(probe=True, why="the marker was seen only outside the gate")
             cmd = self._decide(t, pair, position, seen.disparity, invalid)
+            cmd, invalid = self._measured_first(t, cmd, invalid)
             cmd, invalid = self._watch_lane(frame, t, cmd, invalid)
         stalled = self.progress.update(t, cmd.phase, cmd.error_m, self.target_m,
                                        waiting=bool(waiting) or self.recovery.active)
@@ -1099,6 +1140,7 @@ class Servo:
         assert self._strips is not None
         self._strips.reset()
         self._remeasure_t = None
+        self._measured_t = frame.t_left
         self.notes.append(f"re-referenced after the camera moved {dy:+.1f} rows: target at "
                           f"{target.disparity:.2f} px")
         return ""
@@ -1124,6 +1166,7 @@ class Servo:
         self.recovery.update(frame.t_left, True)
         self._targets_before.pop()
         self.tracker = TargetTracker(found, self.tracker.min_area, self.cfg.tracker)
+        self._measured_t = frame.t_left
         self.controller.target_m = self.geometry.depth_m(found.disparity)
         self.controller.keep_out = self._extent(object_extent(clean, found))
         self.notes.append(f"back to the target it replaced, at {found.disparity:.2f} px")

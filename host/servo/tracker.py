@@ -6,7 +6,11 @@ match). When most of its area twice shows what lay behind it and its two views n
 at its disparity (a map spoilt by flicker is not a box gone) the target is gone: the next
 nearest object becomes the target once two running re-measures find it at the same place and
 depth, its two views agreeing (the wall behind is no object); none within three more
-re-measures, the run ends ("target vanished"; a pure state machine)."""
+re-measures, the run ends ("target vanished"; a pure state machine).
+A depth gone old (aged: no re-measure for longer than a box move may go unseen, e.g. over a
+turn) is confirmed afresh: by a reading agreeing with it, or, the target moved, by two
+readings agreeing with each other (their mean at once, not a median with the old value);
+until then it is unconfirmed (`confirmed` False) and the servo does not drive on it."""
 
 from __future__ import annotations
 
@@ -32,6 +36,7 @@ class TrackerConfig:
     successor_tries: int = 3  # re-measures after "gone" without one: the run ends
     object_width: float = 0.6  # of the image's width: wider is the wall behind, no object
     same_depth: float = 0.35  # of its disparity: a target moved farther is another object
+    fresh_agree: float = 0.01  # of its disparity: two readings this close agree (aged depth)
 
 
 class TargetTracker:
@@ -45,12 +50,26 @@ class TargetTracker:
         self.nearer = NearerObject()
         self.successor = NearerObject(frames=config.successor)  # the next object, once gone
         self.gone = 0  # re-measures since the target was found gone (0: it is not)
+        self.measured = False  # the last update measured the target's depth
+        self.fresh: list[float] | None = None  # readings since the depth aged (None: not
+        # aged, the depth confirmed)
+
+    @property
+    def confirmed(self) -> bool:
+        """The target's depth is not an aged one waiting to be measured again."""
+        return self.fresh is None
+
+    def aged(self) -> None:
+        """The target's depth has gone unmeasured too long: the next readings must confirm
+        it (one agreeing with it) or replace it (two agreeing with each other)."""
+        if self.fresh is None:
+            self.fresh = []
 
     def update(self, disp: np.ndarray, agreement: Callable[[Target], float] = lambda t: 1.0
                ) -> Target:
         """Measure again on disp (px, NaN = invalid: floor and robot left out): the target.
         agreement: how well a region's two views match at its disparity (views_agree)."""
-        self.retargeted = False
+        self.retargeted = self.measured = False
         old = self.target
         bx, by, bw, bh = old.bbox
         there = disp[by:by + bh, bx:bx + bw]
@@ -82,7 +101,8 @@ class TargetTracker:
         if behind >= old.area // 2 and not agreement(old) >= self.cfg.still_there:
             moved = self._moved_back(disp, agreement)
             if moved is not None:  # the target moved farther, where it was: follow it,
-                self.history = [moved.disparity] * (self.cfg.history - 1)  # at its new depth
+                if self.fresh is None:  # at its new depth (aged: once two readings agree)
+                    self.history = [moved.disparity] * (self.cfg.history - 1)
                 return self.update_found(moved)
             n = self._doubt[0] + 1 if self._doubt[1] == "vanished" else 1
             self._doubt = (n, "vanished")
@@ -99,18 +119,41 @@ class TargetTracker:
         self.nearer.reset()
         self.target = found
         self.history = [found.disparity] * (self.cfg.history - 1)
-        self.retargeted = True
+        self.retargeted = self.measured = True
+        self.fresh = None
         return found
 
     def update_found(self, found: Target) -> Target:
         """The target found again (moved or not): its disparity the median of the last
-        `history` measures."""
+        `history` measures; an aged depth, confirmed or replaced first (_confirm)."""
         self._doubt = (0, "")
         self.successor.reset()
+        if self.fresh is not None:
+            return self._confirm(found)
+        self.measured = True
         self.history.append(found.disparity)
         del self.history[:-self.cfg.history]
         median = float(np.median(self.history))
         self.target = Target(median, found.area, found.bbox, found.spread)
+        return self.target
+
+    def _confirm(self, found: Target) -> Target:
+        """A reading of an aged target: agreeing with its depth, it confirms it (and joins the
+        median); else it waits for the next, and two agreeing with each other are the target
+        moved: their mean at once. One reading alone moves nothing (a phantom, a spoilt map)."""
+        assert self.fresh is not None
+        d, held = found.disparity, self.target.disparity
+        tol = self.cfg.fresh_agree * held
+        if abs(d - held) <= tol:
+            self.fresh = None
+            return self.update_found(found)
+        self.fresh.append(d)
+        if len(self.fresh) < 2 or abs(self.fresh[-1] - self.fresh[-2]) > tol:
+            return self.target
+        self.history = self.fresh[-2:]
+        self.fresh = None
+        self.measured = True
+        self.target = Target(float(np.mean(self.history)), found.area, found.bbox, found.spread)
         return self.target
 
     def _moved_back(self, disp: np.ndarray, agreement: Callable[[Target], float]
@@ -155,5 +198,6 @@ class TargetTracker:
         self.successor.reset()
         self.target = vouched
         self.history = [vouched.disparity] * (self.cfg.history - 1)
-        self.retargeted = True
+        self.retargeted = self.measured = True
+        self.fresh = None
         return vouched

@@ -1,7 +1,8 @@
 """The target kept true during the run, and time taken from the frames' capture timestamps:
-a box pushed nearer mid-run is followed; frames that were captured long apart stop the robot
-even when the processing clock runs steadily; a pair whose two views are captured too far apart
-is not used."""
+a box pushed nearer mid-run is followed; a box moved during a turn is measured again before
+the robot drives on it (Servo._measured_first), at the cost of a few frames' standing; frames
+that were captured long apart stop the robot even when the processing clock runs steadily; a
+pair whose two views are captured too far apart is not used."""
 
 from __future__ import annotations
 
@@ -109,3 +110,43 @@ def test_a_hidden_marker_does_not_make_the_robot_the_target() -> None:
         sim.run(sim.source.t + 8.0)
         assert sim.servo.outcome() == ("held", "")
         assert abs(sim.world.robot.z_m - 1.2) <= 0.02
+
+
+def test_a_box_moved_during_a_turn_is_measured_before_the_robot_drives() -> None:
+    """Seed 11's trial 135, constructed: the robot behind the target box (1.42 m, box at
+    1.17 m) faces away, probes, and turns round to come back; mid-turn the box is moved to
+    1.29 m, 8 cm from the body's front. After the turn the robot stands until the target is
+    measured again: it never drives on the old depth (on the servo before it drove at once
+    on 1.17 m, in the trial into the box's edge), and holds at the new one (here the body
+    passes 6 cm clear of the box's edge; in the trial, across it, the controller's block rule
+    now stops it, named)."""
+    boxes = (Box(1.17, -0.50, -0.18, 0.38), Box(1.8, 0.22, 0.55, 0.30),
+             Box(2.4, 0.60, 0.95, 0.55))
+    with simulation(Setup((320, 240), 1.42, -0.05, 0.06, boxes=boxes)) as sim:
+        turned = moved = False
+        while sim.source.t < 15.0 and not sim.servo.stop_reason and not sim.servo.held_for(1.0):
+            sim.step()
+            row = sim.servo.rows[-1]
+            if row.phase == "turn" and not turned:  # moved 1 s into the turn
+                sim.source.events.append(Event(sim.source.t + 1.0, "move", 0, z_m=1.29))
+            turned = turned or row.phase == "turn"
+            moved = moved or sim.world.boxes[0].z_m > 1.2
+            if turned and moved and row.phase in ("drive", "creep"):
+                assert abs(row.target_m - 1.29) < 0.03, (row.t, row.target_m)
+        assert turned and moved
+        assert any(r.reason.startswith("re-measuring the target") for r in sim.servo.rows)
+        assert abs(sim.servo.target_m - 1.29) < 0.03
+        assert sim.servo.outcome() == ("held", "") and abs(sim.depth_error_m()) <= 0.02
+
+
+def test_a_turn_with_nothing_moved_costs_a_few_frames_of_standing() -> None:
+    """The same turn, the box left where it was: after it the robot stands only while one
+    re-measure (two frames at 320x240) confirms the depth, the re-measures running back to
+    back while it is aged (not at the next of the once-a-second ones), then holds at the box."""
+    with simulation(Setup((320, 240), 1.42, -0.05, 0.06)) as sim:
+        sim.run(15.0)
+        rows = sim.servo.rows
+        assert any(r.phase == "turn" for r in rows)
+        standing = [r for r in rows if r.reason.startswith("re-measuring the target")]
+        assert 1 <= len(standing) <= 4, [(r.t, r.reason) for r in standing]
+        assert sim.servo.outcome() == ("held", "") and abs(sim.depth_error_m()) <= 0.02
