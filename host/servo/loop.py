@@ -57,7 +57,7 @@ from host.servo.controller import (
 )
 from host.servo.deflicker import deflickered
 from host.servo.estimator import AGAINST, OUTSIDE, STILL, Estimator, EstimatorConfig, Sighting
-from host.servo.inputs import FrozenSensors, camera_moved, views_agree
+from host.servo.inputs import FrozenSensors, camera_moved, floor_shift_px, views_agree
 from host.servo.marker import RING_RATIO, MarkerPair, block_disparity, cut_views, marker_candidates
 from host.servo.perception import (
     Floor,
@@ -86,6 +86,7 @@ from host.servo.recovery import OUTSIDE as OUTSIDE_KIND
 from host.servo.refind import FOUND, WHOLE, Refind, RefindConfig
 from host.servo.rereference import (
     fill_hidden,
+    floor_follows_picture,
     refit_floor,
     rereference_fault,
     target_shift_rows,
@@ -504,8 +505,10 @@ class Servo:
         if self._reference_image is not None:  # the picture's shift, measured once a frame
             dy = vertical_shift_px(self._reference_image, frame.left)
             limit = self.cfg.moved_rows * self.geometry.focal_px
-            if moved and abs(dy) >= limit:  # and the picture itself moved: an object put
-                # down over the floor's rows shifts their disparity too
+            if moved and abs(dy) >= limit and self.floor is not None and floor_follows_picture(
+                    floor_shift_px(disp, self.floor, reference=self.reference_map), dy,
+                    self.floor):  # and the picture itself moved, as far as the floor: an
+                # object put down over the floor's rows shifts their disparity too
                 self._reref, self._reref_fails = [], 0
                 self._recover(frame.t_left, MOVED, f"{moved} (the picture moved {dy:+.1f} rows)")
                 return

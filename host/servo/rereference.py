@@ -79,6 +79,16 @@ class RereferenceLimits:
     agreement: float = 0.6
 
 
+def floor_follows_picture(floor_px: float, shift_rows: float, floor: Floor,
+                          limits: RereferenceLimits = RereferenceLimits()) -> bool:
+    """Whether the floor's rows, floor_px off their fit (inputs.floor_shift_px), moved as a
+    pitch that moved the picture shift_rows moves them: the horizon by those rows, within
+    horizon_rows (a floor row's disparity changes by -slope x rows). Someone walking past near
+    the camera fills the floor's rows with what no pitch explains, and the phase correlation
+    may read them as a shift for a moment: that is no moved camera."""
+    return abs(-floor_px / floor.slope - shift_rows) <= limits.horizon_rows
+
+
 def target_shift_rows(reference: np.ndarray, image: np.ndarray, box: tuple[int, int, int, int],
                       max_rows: int, max_cols: int = 4, min_score: float = 0.25,
                       hide: tuple[int, int, int, int] | None = None) -> float:
