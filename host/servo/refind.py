@@ -44,6 +44,9 @@ class RefindConfig:
     turn_window_s: float = 2.0  # the drive's steering that may have turned the card away
     stand_s: float = 3.0  # lost without a turn: stand this long, then the whole view (a
     # walker or a hand passes in under 1.5 s)
+    back_frames: int = 3  # the card seen this many frames running ends a loss: a glimpse
+    # (one frame in a few, a far card turned near the detector's edge) does not, or each one
+    # restarts the wait_s count and the refind never begins (seed 11's trial 868)
 
 
 class Refind:
@@ -97,6 +100,8 @@ class LostCard:
         self.drive_depths: list[float] = []  # admitted while driving one way, this heading
         self.drive_facing, self.drive_toward = True, 0  # that heading and way
         self.lost_since: float | None = None  # the controller has said "lost" since then
+        self.seen_run = 0  # frames the card was seen running (back_frames ends a loss)
+        self.lost_now = False  # the controller says "lost" this frame
         self.off_square = 0.0  # the wheels' turn since the card was last square
 
     def update(self, t: float, was: Command, cmd: Command, aspect: float | None,
@@ -117,15 +122,19 @@ class LostCard:
         else:
             self.off_square += (was.right - was.left) * dt
         self._track_drive(depth, cmd, target_m, facing_away)
-        if cmd.phase != Phase.LOST:
-            self.lost_since = None
-        elif self.lost_since is None:
-            self.lost_since = t
+        self.seen_run = 0 if aspect is None else self.seen_run + 1
+        self.lost_now = cmd.phase == Phase.LOST
+        if self.lost_now:
+            self.lost_since = t if self.lost_since is None else self.lost_since
+        elif self.seen_run >= self.cfg.back_frames or cmd.phase not in (
+                Phase.WAIT, *DRIVING):  # back for good, or another phase took over (a hold,
+            self.lost_since = None  # a turn, a stop): glimpses between "lost" do not end it
 
     def lost_while_driving(self, t: float) -> bool:
-        """"lost" for wait_s, with a drive in the turn window: the refind may begin."""
-        return self.lost_since is not None and t - self.lost_since >= self.cfg.wait_s and \
-            any(e[2] for e in self.steered)
+        """"lost" now and for wait_s but for glimpses, with a drive in the turn window: the
+        refind may begin."""
+        return self.lost_now and self.lost_since is not None and \
+            t - self.lost_since >= self.cfg.wait_s and any(e[2] for e in self.steered)
 
     def turned(self) -> float:
         """Which way the card turned (right - left, permille x s): since it was square, else
