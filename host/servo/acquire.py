@@ -12,7 +12,8 @@ way the robot faces by what a short probe move does (a pure state machine, one c
              the last five sightings against the first five's): the way it faces follows
              from the sign of that move (at probe_s, from the sign of the move so far);
              nothing moved by probe_s: the run stops with that reason; the marker unseen for
-             probe_gap_s (the robot stands): the probe's clock stops meanwhile;
+             probe_gap_s (the robot stands): the probe's clock stops meanwhile, but for the
+             gap's first run_down_s (the last drive's reaction and run-down);
              a probe started again (after a stale frame, a knock) runs within what is left
              of probe_s: probe_s bounds its clock, and so its travel, in all until a
              sighting is proven; used up, it decides as at probe_s on the sightings since
@@ -55,6 +56,8 @@ class AcquireConfig:
     probe_m: float = 0.02
     probe_s: float = 1.5  # a robot that can move has moved by then
     probe_gap_s: float = 0.3  # the marker unseen this long in the probe: its clock stops
+    run_down_s: float = 0.33  # of such a gap still counted: the last drive's reaction and
+    # the wheels' run-down moved the robot on (the servo's react_s)
 
 
 @dataclass(frozen=True)
@@ -177,8 +180,11 @@ class Acquisition:
             # unseen meanwhile (hidden by something passing), standing: the probe's clock
             # stops for the gap; timed on, it would find that the marker "did not move" and
             # leave the true marker out as a look-alike (dev seed 104's trial 61: "never
-            # seen"). Its driving time, and so its travel, stays within probe_s
-            self._t0 += gap
+            # seen"). Its driving time, and so its travel, stays within probe_s: the gap's
+            # first run_down_s counts, the robot moved on in it (counted as nothing, a card
+            # seen only in glimpses drove the probe a frame at a time for ever: dev seed 105's
+            # trial 47 went 15 cm sideways in 22 glimpses)
+            self._t0 += gap - min(gap, cfg.run_down_s)
         self._track.append((t, *position))
         late, moved, dz = t - self._t0 > cfg.probe_s, 0.0, 0.0
         # started again: its clock in all is bounded too; up, it decides on what it has seen

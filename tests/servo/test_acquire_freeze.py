@@ -76,6 +76,29 @@ def test_a_restarted_probe_out_of_time_that_did_not_move_stops() -> None:
     assert acq.fault.startswith("the probe move, started again") and not acq.done
 
 
+def test_a_probe_seen_only_in_glimpses_is_timed_with_the_wheels_run_down() -> None:
+    """Turned 49 degrees at 2.27 m, the card seen one frame in ten: each glimpse drove the probe
+    for a frame, and the clock, stopped for each gap, counted only that frame, not the command's
+    reaction and run-down that moved the robot on; 22 glimpses took it 15 cm sideways (dev seed
+    105's trial 47, unsafe by the probe's bound). Each glimpse now costs the run-down too."""
+    acq = Acquisition(AcquireConfig())
+    t, x = 0.0, 0.1
+    while acq.phase != Phase.PROBE:
+        t += 0.033
+        acq.update(t, (2.27, x), 12.0, noise_m=0.03)
+    glimpses = 0
+    while acq.phase == Phase.PROBE and not acq.fault and glimpses < 30:
+        t += 0.033
+        order = acq.update(t, (2.27, x), 12.0, noise_m=0.03)
+        glimpses += 1
+        x += 0.007 if order.left else 0.0  # its drive and run-down, sideways
+        for _ in range(15):  # 0.5 s unseen, standing
+            t += 0.033
+            acq.update(t, None, None, noise_m=0.03)
+    assert acq.done or acq.fault
+    assert x - 0.1 < 0.06, glimpses
+
+
 def test_an_interrupted_measure_begins_again() -> None:
     acq = Acquisition(AcquireConfig())
     acq.update(0.0, (1.2, 0.0), 20.0)
