@@ -12,11 +12,16 @@ way the robot faces by what a short probe move does (a pure state machine, one c
              the last five sightings against the first five's): the way it faces follows
              from the sign of that move (at probe_s, from the sign of the move so far);
              nothing moved by probe_s: the run stops with that reason; the marker unseen for
-             probe_gap_s (the robot stands): the probe's clock stops meanwhile;
+             probe_gap_s (the robot stands): the probe's clock stops meanwhile, but for the
+             gap's first run_down_s (the last drive's reaction and run-down);
              a probe started again (after a stale frame, a knock) runs within what is left
              of probe_s: probe_s bounds its clock, and so its travel, in all until a
              sighting is proven; used up, it decides as at probe_s on the sightings since
-             its last start (ten at least), or the run stops with that reason (PROBED_OUT)
+             its last start (ten at least), or, with fewer, the robot stands and ten
+             standing sightings against the measure's from before the probe decide on the
+             whole move of its starts (beyond probe_m and three of a sighting's noise; a
+             far robot backed 10 cm, its move not yet clear, when a stale frame restarted
+             it: dev seed 105's trial 24); not within probe_s: the run stops (PROBED_OUT)
              (skipped in a re-acquisition that knows the heading: done after the measure)
     a find that fails in a re-acquisition (again: why) says so: "not found again", not
     "never seen"
@@ -51,6 +56,8 @@ class AcquireConfig:
     probe_m: float = 0.02
     probe_s: float = 1.5  # a robot that can move has moved by then
     probe_gap_s: float = 0.3  # the marker unseen this long in the probe: its clock stops
+    run_down_s: float = 0.33  # of such a gap still counted: the last drive's reaction and
+    # the wheels' run-down moved the robot on (the servo's react_s)
 
 
 @dataclass(frozen=True)
@@ -75,6 +82,10 @@ class Acquisition:
         self.again = again
         self.phase = Phase.FIND if config.noise_frames > 0 else Phase.DONE
         self.disparities: list[float] = []  # the standing robot's, for its noise
+        self.depths: list[float] = []  # the standing robot's in the measure (m)
+        self._after: list[float] | None = None  # standing after a probe out of time (m)
+        self._after_t0 = 0.0
+        self._out_s = 0.0  # the probe's time in all when it ran out
         self.facing_away = facing_away  # learnt by the probe (None: not yet)
         self.probes = facing_away is None
         self.fault = ""  # why the run must end, "" if none
@@ -101,12 +112,15 @@ class Acquisition:
             if disparity is not None:
                 self._seen_t = t
                 self.disparities.append(disparity)
+                if position is not None:
+                    self.depths.append(position[0])
                 if len(self.disparities) >= self.cfg.noise_frames:
                     self._begin(Phase.PROBE if self.probes else Phase.DONE, t)
             elif t - max(self._t0, self._seen_t) > self.cfg.find_wait_s:
                 # gone again before the measure was done (seen edge-on at the end of a turn,
                 # a glimpse): find it again, spinning if need be, rather than wait for ever
                 self.disparities.clear()
+                self.depths.clear()
                 self._begin(Phase.FIND, t)
             return Order(0, 0, Phase.MEASURE)
         if self.phase == Phase.PROBE:
@@ -129,6 +143,9 @@ class Acquisition:
             self.spent_s = self.driven_s()  # its travel stays (the evidence does not)
             if self.phase == Phase.MEASURE:
                 self.disparities.clear()
+                self.depths.clear()
+            if self._after is not None:
+                self._after.clear()
             self._track.clear()
             self._t0 = None  # the phase's clock starts again at the next usable frame
 
@@ -154,6 +171,8 @@ class Acquisition:
     def _probe(self, t: float, position: tuple[float, float] | None, noise_m: float) -> Order:
         assert self._t0 is not None
         cfg = self.cfg
+        if self._after is not None:
+            return self._standing_after(t, position, noise_m)
         if position is None:
             return Order(0, 0, Phase.PROBE)  # not seen: stand until it is
         gap = t - (self._track[-1][0] if self._track else self._t0)
@@ -161,15 +180,22 @@ class Acquisition:
             # unseen meanwhile (hidden by something passing), standing: the probe's clock
             # stops for the gap; timed on, it would find that the marker "did not move" and
             # leave the true marker out as a look-alike (dev seed 104's trial 61: "never
-            # seen"). Its driving time, and so its travel, stays within probe_s
-            self._t0 += gap
+            # seen"). Its driving time, and so its travel, stays within probe_s: the gap's
+            # first run_down_s counts, the robot moved on in it (counted as nothing, a card
+            # seen only in glimpses drove the probe a frame at a time for ever: dev seed 105's
+            # trial 47 went 15 cm sideways in 22 glimpses)
+            self._t0 += gap - min(gap, cfg.run_down_s)
         self._track.append((t, *position))
         late, moved, dz = t - self._t0 > cfg.probe_s, 0.0, 0.0
         # started again: its clock in all is bounded too; up, it decides on what it has seen
         # since the last start (at least ten sightings, as ever), or stops without them
         out = self.spent_s > 0 and self.spent_s + t - self._t0 > cfg.probe_s
         if out and len(self._track) < 10:
-            self.fault = PROBED_OUT.format(self.spent_s + t - self._t0)
+            self._out_s = self.spent_s + t - self._t0
+            if len(self.depths) < 5:
+                self.fault = PROBED_OUT.format(self._out_s)
+            else:  # stand, and decide on the whole move (_standing_after)
+                self._after, self._after_t0 = [], t
             return Order(0, 0, Phase.PROBE)
         late = late or out
         if len(self._track) >= 10:
@@ -194,6 +220,28 @@ class Acquisition:
                    cfg.probe_duty + cfg.probe_step * int((t - self._t0) / cfg.probe_step_s))
         duty *= self.direction
         return Order(duty, duty, Phase.PROBE)
+
+    def _standing_after(self, t: float, position: tuple[float, float] | None,
+                        noise_m: float) -> Order:
+        """The probe's time ran out, started again, before ten sightings since its last start:
+        the robot stands; the median of ten standing sightings against the measure's (standing
+        before the probe) is the whole move of the probe's starts, and decides the heading as
+        the probe would (beyond probe_m and three of a sighting's noise); no such move, or not
+        ten sightings within probe_s: PROBED_OUT."""
+        cfg = self.cfg
+        assert self._after is not None
+        if position is not None:
+            self._after.append(position[0])
+        if len(self._after) >= 10:
+            dz = float(np.median(self._after) - np.median(self.depths))
+            if abs(dz) >= max(cfg.probe_m, 3 * noise_m):
+                self.facing_away = (dz > 0) == (self.direction > 0)
+                self._begin(Phase.DONE, t)
+            else:
+                self.fault = PROBED_OUT.format(self._out_s)
+        elif t - self._after_t0 > cfg.probe_s:
+            self.fault = PROBED_OUT.format(self._out_s)
+        return Order(0, 0, Phase.PROBE)
 
     def noise_px(self) -> float:
         """The standing robot's disparity noise a frame (px, standard deviation)."""

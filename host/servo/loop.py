@@ -83,7 +83,7 @@ from host.servo.phase import Phase
 from host.servo.progress import Progress, ProgressConfig
 from host.servo.recovery import LANE, LOST, MOVED, RESET, RESUME, TARGET, Recovery, servo_bounds
 from host.servo.recovery import OUTSIDE as OUTSIDE_KIND
-from host.servo.refind import FOUND, WHOLE, Refind, RefindConfig
+from host.servo.refind import FOUND, WHOLE, LostCard, Refind, RefindConfig
 from host.servo.rereference import (
     fill_hidden,
     floor_follows_picture,
@@ -271,12 +271,7 @@ class Servo:
         self._targets_before: list[Target] = []  # the targets a nearer object replaced
         self.progress = Progress(self.cfg.progress)  # no progress for long: the run ends
         self.refind: Refind | None = None  # the card lost while driving, looked for (refind.py)
-        self._steered: list[tuple[float, int, bool]] = []  # (t, right - left, driving) of the
-        # command in force up to t, over the refind's turn window
-        self._drive_depths: list[float] = []  # admitted while driving one way, this heading
-        self._drive_facing, self._drive_toward = True, 0  # that heading and way
-        self._lost_since: float | None = None  # the controller has said "lost" since then
-        self._off_square = 0.0  # the wheels' turn since the card was last square (refind)
+        self.lost_card = LostCard(self.cfg.refind)  # the refind's bookkeeping (refind.py)
 
     @property
     def strips(self) -> StripMap | None:
@@ -899,56 +894,36 @@ class Servo:
         is square to the camera again, or it is looked for in the whole view through the
         acquisition (refind.py); a wait recovery.py bounds (kind "lost"). aspect, depth: the
         card's this frame, None when no sighting was admitted. Returns the command to send.
-        Each loss also checks the heading over the drives since the last (_drove_against):
-        a far robot's depth is too noisy for the motion check within one short drive. And
-        a drive that would turn the card farther from square when it is already turned
-        (_keep_in_view) is driven straight instead."""
+        Each loss also checks the heading over the drives since the last
+        (LostCard.drove_against): a far robot's depth is too noisy for the motion check within
+        one short drive. And a drive that would turn the card farther from square when it is
+        already turned (LostCard.keep_in_view) is driven straight instead."""
         c = self.controller
         assert c is not None
-        was = self._cmd
-        drove = was.phase in (Phase.DRIVE, Phase.CREEP) and not was.is_stop
-        dt = t - self._steered[-1][0] if self._steered else 0.0
-        self._steered.append((t, was.right - was.left if drove else 0, drove))
-        window = self.cfg.refind.turn_window_s
-        self._steered = s = [e for e in self._steered if t - e[0] <= window]
-        # the turn since the card was last square to the camera (any wheel difference in
-        # force, spins included: permille x s; its sign says which way the card turned)
-        if aspect is not None and aspect >= self.cfg.refind.square or cmd.phase == Phase.TURN \
-                or dt > 0.25:  # (a turn round ends at an angle it measures itself; frames
-            self._off_square = 0.0  # not decided here, an acquisition's, are not counted)
-        else:
-            self._off_square += (was.right - was.left) * dt
-        self._track_drive(depth, cmd)
+        lc = self.lost_card
+        lc.update(t, self._cmd, cmd, aspect, depth, c.target_m, c.facing_away)
         rec = self.recovery
         if self.refind is not None and rec.kind != LOST:
             self.refind = None  # another wait took over (the robot stands in it)
-        if cmd.phase != Phase.LOST:
-            self._lost_since = None
-        elif self._lost_since is None:
-            self._lost_since = t
         if self.refind is None:
-            driving = any(e[2] for e in s)
-            if self._lost_since is None or t - self._lost_since < self.cfg.refind.wait_s or \
-                    not driving or not self.cfg.recover or rec.active:
-                return self._keep_in_view(aspect, cmd)  # a card missing a few frames (far,
+            if not lc.lost_while_driving(t) or not self.cfg.recover or rec.active:
+                return lc.keep_in_view(aspect, cmd)  # a card missing a few frames (far,
                 # small) is waited for
             reason = "the marker was lost while driving"
-            if self._drove_against() and not self._turn_round(
+            if lc.drove_against() and not self._turn_round(
                     "over the drives before the marker was lost the depth moved against the "
                     "commanded direction"):
                 return Command(0, 0, Phase.STOP, None)
             if not self._recover(t, LOST, reason):
                 return Command(0, 0, Phase.STOP, None)
-            # which way the card turned: since it was square, else by the last drives
-            turned = self._off_square or sum(b[1] * (b[0] - a[0]) for a, b in zip(s, s[1:]))
-            self.refind = Refind(t, turned, self.cfg.refind)
+            self.refind = Refind(t, lc.turned(), self.cfg.refind)
         left, right = self.refind.update(t, aspect)
         outcome = self.refind.outcome
         if outcome == FOUND:
             rec.update(t, True)
             self.refind = None
             self.notes.append("the card lost while driving was found again")
-            return self._keep_in_view(aspect, cmd)  # the controller's own, on this sighting
+            return lc.keep_in_view(aspect, cmd)  # the controller's own, on this sighting
         if outcome == WHOLE:
             rec.update(t, True)
             self.refind = None
@@ -956,45 +931,6 @@ class Servo:
                             keep_estimate=True)
             return Command(0, 0, Phase.FIND, None)
         return Command(left, right, Phase.SEARCH, None)
-
-    def _keep_in_view(self, aspect: float | None, cmd: Command) -> Command:
-        """A drive whose wheel difference would turn the card farther from square when its
-        aspect is already below refind.view (about 30 degrees off) is driven straight at its
-        mean duty: the card stays in view (far away, a card much past 40 degrees is lost)."""
-        if aspect is None or aspect >= self.cfg.refind.view or cmd.is_stop or \
-                cmd.phase not in (Phase.DRIVE, Phase.CREEP):
-            return cmd
-        if (cmd.right - cmd.left) * self._off_square <= 0:
-            return cmd  # it turns the card back toward square (or not at all)
-        mean = (cmd.left + cmd.right) // 2
-        return Command(mean, mean, cmd.phase, cmd.error_m)
-
-    def _track_drive(self, depth: float | None, cmd: Command) -> None:
-        """The depths admitted while driving one way with one heading (_drove_against)."""
-        c = self.controller
-        assert c is not None
-        toward = 0 if depth is None else (1 if c.target_m > depth else -1)
-        if cmd.phase in (Phase.DRIVE, Phase.CREEP) and depth is not None and \
-                c.facing_away == self._drive_facing and toward == self._drive_toward:
-            self._drive_depths.append(depth)
-        elif cmd.phase in (Phase.DRIVE, Phase.CREEP, Phase.TURN) or \
-                c.facing_away != self._drive_facing:
-            self._drive_depths = [] if depth is None else [depth]
-            self._drive_facing, self._drive_toward = c.facing_away, toward
-
-    def _drove_against(self) -> bool:
-        """Whether the depths admitted while driving one way since the heading was last set
-        moved against that way: the median of the last five against the first five's, beyond
-        5 cm and three of that difference's noise (from the sightings' own frame-to-frame
-        spread, which moving shows and standing does not)."""
-        z = self._drive_depths
-        if len(z) < 10:
-            return False
-        steps = np.diff(z)
-        sigma = float(np.median(np.abs(steps - np.median(steps)))) * 1.4826 / math.sqrt(2)
-        dz = float(np.median(z[-5:]) - np.median(z[:5]))
-        # a median of five has about 0.54 of a sighting's noise; the difference of two, 0.77
-        return dz * self._drive_toward < -max(0.05, 3 * 0.77 * sigma)
 
     def _must_stop(self) -> bool:
         return bool(self.stop_reason)

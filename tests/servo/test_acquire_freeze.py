@@ -33,6 +33,72 @@ def test_an_interrupted_probe_begins_again_and_finds_the_heading() -> None:
     assert not acq.fault and acq.done and acq.facing_away is True
 
 
+def test_a_restarted_probe_out_of_time_decides_standing_on_its_whole_move() -> None:
+    """Far away (2.74 m, a sighting's depth noise 3 cm) the probe backed the robot 8 cm in 1.3 s
+    without the move clear beyond three noises; a stale frame then started it again, and the
+    time left ran out before ten sightings: the run stopped though the robot had moved (dev
+    seed 105's trial 24, no events). The robot stands and ten standing sightings against the
+    measure's from before the probe decide the heading on the whole move."""
+    acq = Acquisition(AcquireConfig())
+    t, z = 0.0, 2.74
+    while acq.phase != Phase.PROBE:  # find and measure, standing
+        t += 0.033
+        acq.update(t, (z, 0.0), 12.0, noise_m=0.03)
+    acq.direction = -1
+    while t < 1.6:  # backing, facing away: the depth falls
+        t += 0.033
+        order = acq.update(t, (z, 0.0), 12.0, noise_m=0.03)
+        z -= 0.002 if order.left < 0 else 0.0
+    assert acq.phase == Phase.PROBE and 2.65 < z < 2.7
+    acq.interrupted(t)  # a stale frame
+    orders = []
+    while acq.phase == Phase.PROBE and not acq.fault and t < 5.0:
+        t += 0.033
+        orders.append(acq.update(t, (z, 0.0), 12.0, noise_m=0.03))
+        z -= 0.002 if orders[-1].left < 0 else 0.0
+    assert not acq.fault and acq.done and acq.facing_away is True
+    assert z > 2.6  # the probe's travel stayed within its time: the robot stood to decide
+
+
+def test_a_restarted_probe_out_of_time_that_did_not_move_stops() -> None:
+    acq = Acquisition(AcquireConfig())
+    t = 0.0
+    while acq.phase != Phase.PROBE:
+        t += 0.033
+        acq.update(t, (2.74, 0.0), 12.0, noise_m=0.03)
+    while t < 1.6:  # a look-alike: it does not move
+        t += 0.033
+        acq.update(t, (2.74, 0.0), 12.0, noise_m=0.03)
+    acq.interrupted(t)
+    while not acq.fault and t < 6.0:
+        t += 0.033
+        acq.update(t, (2.74, 0.0), 12.0, noise_m=0.03)
+    assert acq.fault.startswith("the probe move, started again") and not acq.done
+
+
+def test_a_probe_seen_only_in_glimpses_is_timed_with_the_wheels_run_down() -> None:
+    """Turned 49 degrees at 2.27 m, the card seen one frame in ten: each glimpse drove the probe
+    for a frame, and the clock, stopped for each gap, counted only that frame, not the command's
+    reaction and run-down that moved the robot on; 22 glimpses took it 15 cm sideways (dev seed
+    105's trial 47, unsafe by the probe's bound). Each glimpse now costs the run-down too."""
+    acq = Acquisition(AcquireConfig())
+    t, x = 0.0, 0.1
+    while acq.phase != Phase.PROBE:
+        t += 0.033
+        acq.update(t, (2.27, x), 12.0, noise_m=0.03)
+    glimpses = 0
+    while acq.phase == Phase.PROBE and not acq.fault and glimpses < 30:
+        t += 0.033
+        order = acq.update(t, (2.27, x), 12.0, noise_m=0.03)
+        glimpses += 1
+        x += 0.007 if order.left else 0.0  # its drive and run-down, sideways
+        for _ in range(15):  # 0.5 s unseen, standing
+            t += 0.033
+            acq.update(t, None, None, noise_m=0.03)
+    assert acq.done or acq.fault
+    assert x - 0.1 < 0.06, glimpses
+
+
 def test_an_interrupted_measure_begins_again() -> None:
     acq = Acquisition(AcquireConfig())
     acq.update(0.0, (1.2, 0.0), 20.0)
