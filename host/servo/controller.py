@@ -69,6 +69,9 @@ class ControlConfig:
     fit_frames: int = 6
     steer_gain: float = 25.0  # permille per cm of sideways drift
     steer_damping: float = 60.0  # permille per cm/s of sideways drift rate
+    square_deg: float = 25.0  # the card's turn from square (its aspect) at which the lane's
+    # pull is gone while the robot closes on its lane: the pull asks for a sideways rate, which
+    # at a slow speed is a steep heading, and a far card turned past ~40 degrees is lost
     trim_gain: float = 0.004  # learnt wheel trim, fraction of duty per cm of drift per second
     max_trim: float = 0.25
     half_width_m: float = 0.08  # the robot's body, centre to side
@@ -150,6 +153,7 @@ class Controller:
         self._search_until: float | None = None
         self._seen_run = 0  # frames the card has been seen running
         self._reversing = False  # this leg is reversed: a turn would sweep into the object
+        self.squaring = False  # this frame's steer turns the card toward square (_drive)
 
     # ---------------------------------------------------------------------- estimates
 
@@ -363,6 +367,7 @@ class Controller:
         duty = self.floor if creeping else min(cfg.max_duty, int(self.floor + gain * abs(e)))
         duty = duty if forward else -duty
         steer = 0.0
+        self.squaring = False
         lane = self.lane(z)
         if obs.lateral_m is not None and lane is not None:
             # x' = v sin(theta): to cancel a drift to the right, turn so that v cos(theta) * dtheta
@@ -375,7 +380,18 @@ class Controller:
                 w = s if forward else -s
                 self.trim = max(-cfg.max_trim, min(cfg.max_trim, self.trim + w * cfg.trim_gain
                                                    * 100 * max(-0.05, min(0.05, drift)) * dt))
-            pd = s * (cfg.steer_gain * 100 * drift + cfg.steer_damping * 100 * xdot) / 2
+            # closing on its lane, the robot's heading already points there (the drift rate says
+            # which way) and the card's aspect says how steeply: past half of square_deg the
+            # lane's pull fades, gone at square_deg, so the damping alone turns the heading back
+            # before the card is turned out of view (the drift rate lags the heading by the
+            # fit's half second; the aspect is this frame's)
+            off = math.degrees(math.acos(min(1.0, obs.aspect)))
+            share = min(1.0, 2.0 - 2.0 * off / cfg.square_deg) if drift * xdot < 0 else 1.0
+            pull = max(0.0, share) * cfg.steer_gain * 100 * drift
+            pd = s * (pull + cfg.steer_damping * 100 * xdot) / 2
+            # this steer turns the robot's travel back toward the camera's axis (against the
+            # sideways motion it measures): the card turns toward square
+            self.squaring = abs(xdot) >= 0.02 and pd * s * xdot > 0
             # creeping (the last few cm) the drift rate is mostly a sideways push, not heading:
             # steering against it turns the robot off the card's visible range and, near the
             # dead zone, spins it in place; only the wheels' trim acts there
