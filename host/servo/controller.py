@@ -153,7 +153,6 @@ class Controller:
         self._search_until: float | None = None
         self._seen_run = 0  # frames the card has been seen running
         self._reversing = False  # this leg is reversed: a turn would sweep into the object
-        self.squaring = False  # this frame's steer turns the card toward square (_drive)
 
     # ---------------------------------------------------------------------- estimates
 
@@ -367,7 +366,6 @@ class Controller:
         duty = self.floor if creeping else min(cfg.max_duty, int(self.floor + gain * abs(e)))
         duty = duty if forward else -duty
         steer = 0.0
-        self.squaring = False
         lane = self.lane(z)
         if obs.lateral_m is not None and lane is not None:
             # x' = v sin(theta): to cancel a drift to the right, turn so that v cos(theta) * dtheta
@@ -389,9 +387,6 @@ class Controller:
             share = min(1.0, 2.0 - 2.0 * off / cfg.square_deg) if drift * xdot < 0 else 1.0
             pull = max(0.0, share) * cfg.steer_gain * 100 * drift
             pd = s * (pull + cfg.steer_damping * 100 * xdot) / 2
-            # this steer turns the robot's travel back toward the camera's axis (against the
-            # sideways motion it measures): the card turns toward square
-            self.squaring = abs(xdot) >= 0.02 and pd * s * xdot > 0
             # creeping (the last few cm) the drift rate is mostly a sideways push, not heading:
             # steering against it turns the robot off the card's visible range and, near the
             # dead zone, spins it in place; only the wheels' trim acts there

@@ -924,10 +924,8 @@ class Servo:
         if aspect is None or aspect >= self.cfg.refind.view or cmd.is_stop or \
                 cmd.phase not in (Phase.DRIVE, Phase.CREEP):
             return cmd
-        if (cmd.right - cmd.left) * self._off_square <= 0 or (
-                self.controller is not None and self.controller.squaring):
-            return cmd  # it turns the card back toward square (or not at all; the
-            # controller's steer against the sideways motion it measures does)
+        if (cmd.right - cmd.left) * self._off_square <= 0:
+            return cmd  # it turns the card back toward square (or not at all)
         mean = (cmd.left + cmd.right) // 2
         return Command(mean, mean, cmd.phase, cmd.error_m)
 

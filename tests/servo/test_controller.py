@@ -151,16 +151,3 @@ def test_a_far_robot_off_its_lane_keeps_its_card_near_square(x0: float) -> None:
         worst = max(worst, math.degrees(math.acos(abs(math.cos(plant.theta)))))
     assert ctl.phase == "hold" and unseen == 0, (worst, unseen, plant.z)
     assert worst < 30.0 and abs(plant.x) < 0.03, (worst, plant.x)
-
-
-def test_a_steep_heading_toward_the_lane_is_turned_back_and_said_so() -> None:
-    """Driving toward the camera 36 degrees off its axis (the card's aspect 0.8), closing on its
-    lane 6 cm away at 11 cm/s sideways: the steer turns the travel back toward the axis (the
-    left wheel faster turns a robot facing the camera toward it) and the controller says so
-    (`squaring`: the loop's keep-in-view then lets it through)."""
-    ctl = Controller(1.2, ControlConfig())
-    ctl.facing_away, ctl.lateral_ref = False, 0.0
-    for i in range(8):
-        t = 0.033 * i
-        cmd = ctl.update(Observation(t, 2.2 - 0.15 * t, -0.06 + 0.11 * t, 0.8))
-    assert cmd.phase == "drive" and ctl.squaring and cmd.left > cmd.right, cmd
