@@ -27,7 +27,9 @@ Lateral: the marker's position x = B (u - cx) / d is held on a lane: where it wa
 unless that line passes the object (keep_out, the object's lateral extent at its depth, from the
 servo) closer than clearance_m, centre to side; then the lane moves to the nearer clear side.
 The drift from the lane and its rate steer the robot (PD, at most half the duty; not while
-creeping, where the drift rate is mostly a sideways push rather than heading), and a trim learnt
+creeping, where the drift rate is mostly a sideways push rather than heading; while the robot
+closes on its lane the drift's pull fades as the card's aspect shows it turned toward
+square_deg, so a steep heading is turned back before the card leaves view), and a trim learnt
 from the drift while driving (an integral, as a fraction of the duty) cancels the wheels'
 unequal gains; no wheel is commanded below the least duty that moves it. When the
 robot comes within block_m of the object's depth while its body still overlaps the object, it
