@@ -27,7 +27,9 @@ Lateral: the marker's position x = B (u - cx) / d is held on a lane: where it wa
 unless that line passes the object (keep_out, the object's lateral extent at its depth, from the
 servo) closer than clearance_m, centre to side; then the lane moves to the nearer clear side.
 The drift from the lane and its rate steer the robot (PD, at most half the duty; not while
-creeping, where the drift rate is mostly a sideways push rather than heading), and a trim learnt
+creeping, where the drift rate is mostly a sideways push rather than heading; while the robot
+closes on its lane the drift's pull fades as the card's aspect shows it turned toward
+square_deg, so a steep heading is turned back before the card leaves view), and a trim learnt
 from the drift while driving (an integral, as a fraction of the duty) cancels the wheels'
 unequal gains; no wheel is commanded below the least duty that moves it. When the
 robot comes within block_m of the object's depth while its body still overlaps the object, it
@@ -69,6 +71,9 @@ class ControlConfig:
     fit_frames: int = 6
     steer_gain: float = 25.0  # permille per cm of sideways drift
     steer_damping: float = 60.0  # permille per cm/s of sideways drift rate
+    square_deg: float = 25.0  # the card's turn from square (its aspect) at which the lane's
+    # pull is gone while the robot closes on its lane: the pull asks for a sideways rate, which
+    # at a slow speed is a steep heading, and a far card turned past ~40 degrees is lost
     trim_gain: float = 0.004  # learnt wheel trim, fraction of duty per cm of drift per second
     max_trim: float = 0.25
     half_width_m: float = 0.08  # the robot's body, centre to side
@@ -374,7 +379,15 @@ class Controller:
                 w = s if forward else -s
                 self.trim = max(-cfg.max_trim, min(cfg.max_trim, self.trim + w * cfg.trim_gain
                                                    * 100 * max(-0.05, min(0.05, drift)) * dt))
-            pd = s * (cfg.steer_gain * 100 * drift + cfg.steer_damping * 100 * xdot) / 2
+            # closing on its lane, the robot's heading already points there (the drift rate says
+            # which way) and the card's aspect says how steeply: past half of square_deg the
+            # lane's pull fades, gone at square_deg, so the damping alone turns the heading back
+            # before the card is turned out of view (the drift rate lags the heading by the
+            # fit's half second; the aspect is this frame's)
+            off = math.degrees(math.acos(min(1.0, obs.aspect)))
+            share = min(1.0, 2.0 - 2.0 * off / cfg.square_deg) if drift * xdot < 0 else 1.0
+            pull = max(0.0, share) * cfg.steer_gain * 100 * drift
+            pd = s * (pull + cfg.steer_damping * 100 * xdot) / 2
             # creeping (the last few cm) the drift rate is mostly a sideways push, not heading:
             # steering against it turns the robot off the card's visible range and, near the
             # dead zone, spins it in place; only the wheels' trim acts there

@@ -37,6 +37,7 @@ from host.camera.source import CameraError, StereoFrame, StereoSource
 from host.errors import HostError
 from host.link.client import RobotLink, RobotReset
 from host.servo.acquire import NOT_MOVED, AcquireConfig, Acquisition
+from host.servo.align import aligned_disparity
 from host.servo.clearance import (
     Body,
     Heading,
@@ -349,7 +350,10 @@ class Servo:
                                        (g.cy + 0.5) / k - 0.5)
         self._lane_reference = self._lane_map(self.reference_map)
         self.tracker = TargetTracker(target, min_area, self.cfg.tracker)
-        self.controller = Controller(self.geometry.depth_m(target.disparity), self.control)
+        # the face's two views aligned: the map's median is pixel-locked (align.py)
+        self.controller = Controller(self.geometry.depth_m(aligned_disparity(
+            f.left, f.right, without_floor(self.reference_map, self.floor), target.bbox,
+            target.disparity)), self.control)
         self.controller.keep_out = self._extent(
             object_extent(without_floor(self.reference_map, self.floor), target))
         self.controller.fixed = fixed_cells(self.reference_map, self.geometry,
@@ -527,7 +531,8 @@ class Servo:
             self.notes.append(f"a nearer object appeared at {target.disparity:.2f} px: "
                               f"retargeting")
             self.controller.keep_out = self._extent(object_extent(clean, target))
-        self.controller.target_m = self.geometry.depth_m(target.disparity)
+        self.controller.target_m = self.geometry.depth_m(aligned_disparity(
+            frame.left, frame.right, clean, target.bbox, target.disparity, hide=hide))
 
     @property
     def tracker_confirmed(self) -> bool:
