@@ -96,15 +96,23 @@ def target_shift_rows(reference: np.ndarray, image: np.ndarray, box: tuple[int, 
     (a picture of the target before the camera moved, rig.reference_image: grey float32)
     moved in image: the best normalised correlation of the region within max_rows up or down
     and max_cols across (within the picture), the pixels of hide (x0, y0, x1, y1: the robot
-    where it stood in reference) left out. NaN when the best scores below min_score (the
+    where it stood in reference) left out. A region within max_rows of the picture's top or
+    bottom is matched on its rows that stay in the picture however far the search goes up or
+    down (a pitch moves a box standing on the floor near the bottom partly out of the
+    picture: seed 11's trial 755, a region reaching 17 rows from the bottom searched 18 rows
+    was NaN); the row found is the same. NaN when the best scores below min_score (the
     region's picture is not there: it was replaced, or something stands in front of it), when
-    hide leaves less than a quarter of the region, or when the search up or down leaves the
-    picture. A pitch warps the picture a little and the sensor's noise is new: a box's front
-    knocked 1.8 degrees scored 0.37-0.49 at its shifted place and under 0.1 elsewhere (dev
-    seed 8's trial 45)."""
+    hide leaves less than a quarter of the region, or when fewer than half its rows (or 8)
+    stay in the picture through the search. A pitch warps the picture a little and the
+    sensor's noise is new: a box's front knocked 1.8 degrees scored 0.37-0.49 at its shifted
+    place and under 0.1 elsewhere (dev seed 8's trial 45)."""
     grey = to_grey(image).astype(np.float32)
     h, w = grey.shape
     x, y, bw, bh = box
+    top, bottom = max(0, max_rows - y), max(0, y + bh + max_rows - h)  # rows left out
+    if bh - top - bottom < max(8, bh / 2):
+        return math.nan
+    y, bh = y + top, bh - top - bottom
     # across, the search stops at the picture's sides (a region cut by the picture's edge
     # reaches it); down, it must reach max_rows both ways
     y0, y1, x0, x1 = y - max_rows, y + bh + max_rows, max(0, x - max_cols), \

@@ -165,3 +165,21 @@ def test_a_target_measured_at_its_new_depth_just_before_the_knock_is_a_re_refere
     farther = Target(19.9, 9166, (26, 56, 73, 134), 0.16)
     assert rereference_fault(OLD_FLOOR, floor, -15.1, old, farther, 0.94,
                              last=21.48).startswith("the nearest object is at 19.90 px")
+
+
+def test_a_target_near_the_pictures_bottom_is_matched_on_the_rows_that_stay_in_it():
+    """Seed 11's trial 755: a box standing on the floor, its region reaching 17 rows from the
+    picture's bottom, the picture moved 14 rows down and searched 18 rows: the search ran
+    past the bottom and the target was NaN (the re-reference refused). Its rows that stay in
+    the picture find it; a region with fewer than half its rows left is still NaN, and a box
+    that is not there any more still is not found."""
+    rng = np.random.default_rng(5)
+    scene = cv2.GaussianBlur(rng.uniform(0, 255, (240, 320)).astype(np.float32), (5, 5), 1.5)
+    moved = (np.roll(scene, 14, axis=0) + rng.normal(0, 3, scene.shape)).astype(np.uint8)
+    assert target_shift_rows(scene, moved, (30, 64, 57, 159), 18) == 14
+    up = (np.roll(scene, -12, axis=0) + rng.normal(0, 3, scene.shape)).astype(np.uint8)
+    assert target_shift_rows(scene, up, (30, 6, 57, 120), 16) == -12  # near the top
+    assert np.isnan(target_shift_rows(scene, moved, (30, 215, 57, 24), 18))  # 7 of 24 rows stay
+    other = rng.uniform(0, 255, (240, 320)).astype(np.uint8)
+    assert np.isnan(target_shift_rows(scene, other, (30, 64, 57, 159), 18))
+
