@@ -3,13 +3,19 @@ picture's shift (host/servo/rereference.py): constructed targets, floors and map
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable
+
 import cv2
 import numpy as np
+import pytest
 
+from host.errors import HostError
 from host.servo.perception import Floor, Target
 from host.servo.rereference import (
     fill_hidden,
     horizon_row,
+    nearest_agreeing,
     rereference_fault,
     target_shift_rows,
 )
@@ -183,3 +189,37 @@ def test_a_target_near_the_pictures_bottom_is_matched_on_the_rows_that_stay_in_i
     other = rng.uniform(0, 255, (240, 320)).astype(np.uint8)
     assert np.isnan(target_shift_rows(scene, other, (30, 64, 57, 159), 18))
 
+
+def _scene(*regions: tuple[tuple[int, int, int, int], float]) -> np.ndarray:
+    """A map (floor taken out: NaN) with rectangular regions (x, y, w, h) at disparities."""
+    disp = np.full((240, 320), np.nan, np.float32)
+    for (x, y, w, h), d in regions:
+        disp[y:y + h, x:x + w] = d
+    return disp
+
+
+def test_a_nearer_region_whose_views_disagree_is_passed_over():
+    """Seed 11's trial 522: after a knock, flicker made regions 8 px nearer than the target
+    whose two views disagree (-0.01 to -0.09); the re-reference took one as the nearest object
+    and refused ("the nearest object is at 31.12 px") with the target where it was. Passed
+    over, the target is found; a nearer object agreeing in both views (a box put down) or
+    without texture to tell is still the one found, and rereference_fault refuses it."""
+    target, phantom = ((22, 67, 89, 76), 17.5), ((150, 100, 40, 30), 25.5)
+
+    def scores(flicker: float) -> Callable[[Target], float]:
+        return lambda t: flicker if t.bbox[0] >= 150 else 0.95
+
+    disp = _scene(target, phantom)
+    found, agree = nearest_agreeing(disp, 1000, scores(-0.05))
+    assert found.bbox == target[0] and abs(found.disparity - 17.5) < 1e-6 and agree == 0.95
+    assert rereference_fault(OLD_FLOOR, _pitched(OLD_FLOOR, UP), UP, TARGET,
+                             Target(found.disparity, found.area, (22, 67, 89, 76), 0.1),
+                             agree) == ""
+    assert not np.isnan(disp).all() and np.nanmax(disp) == 25.5  # the map is left as it was
+    for real in (0.9, math.nan):  # a real box in front: found, and refused
+        box, agree = nearest_agreeing(disp, 1000, scores(real))
+        assert box.bbox == phantom[0] and box.disparity == 25.5
+        assert rereference_fault(OLD_FLOOR, _pitched(OLD_FLOOR, UP), UP, TARGET, box,
+                                 agree) != ""
+    with pytest.raises(HostError):  # nothing agrees: no object
+        nearest_agreeing(disp, 1000, lambda t: -0.05)
