@@ -88,6 +88,7 @@ from host.servo.refind import FOUND, WHOLE, LostCard, Refind, RefindConfig
 from host.servo.rereference import (
     fill_hidden,
     floor_follows_picture,
+    nearest_agreeing,
     refit_floor,
     rereference_fault,
     target_shift_rows,
@@ -1051,11 +1052,12 @@ class Servo:
         floor = refit_floor(reference, self.floor) if self.floor else fit_floor(reference)
         if floor is None:
             return "no floor in the rows the robot leaves free"
-        try:
-            target = nearest_object(without_floor(reference, floor), self.tracker.min_area)
+        try:  # a region whose two views disagree (flicker) is no object: passed over
+            target, agree = nearest_agreeing(
+                without_floor(reference, floor), self.tracker.min_area,
+                lambda t: views_agree(frame.left, frame.right, t.bbox, t.disparity))
         except HostError as e:
             return str(e)
-        agree = views_agree(frame.left, frame.right, target.bbox, target.disparity)
         # the target's picture as the last re-measure saw it (the target may have moved since
         # the reference phase, the robot stand in front of it), else the reference's
         picture, hide = self._target_picture or (self._reference_image, None)

@@ -18,12 +18,14 @@ and the robot stays stopped.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import cv2
 import numpy as np
 
-from host.servo.perception import Floor, Target, span_overlap
+from host.errors import HostError
+from host.servo.perception import Floor, Target, nearest_object, span_overlap
 from host.stereo.grey import to_grey
 
 
@@ -96,15 +98,23 @@ def target_shift_rows(reference: np.ndarray, image: np.ndarray, box: tuple[int, 
     (a picture of the target before the camera moved, rig.reference_image: grey float32)
     moved in image: the best normalised correlation of the region within max_rows up or down
     and max_cols across (within the picture), the pixels of hide (x0, y0, x1, y1: the robot
-    where it stood in reference) left out. NaN when the best scores below min_score (the
+    where it stood in reference) left out. A region within max_rows of the picture's top or
+    bottom is matched on its rows that stay in the picture however far the search goes up or
+    down (a pitch moves a box standing on the floor near the bottom partly out of the
+    picture: seed 11's trial 755, a region reaching 17 rows from the bottom searched 18 rows
+    was NaN); the row found is the same. NaN when the best scores below min_score (the
     region's picture is not there: it was replaced, or something stands in front of it), when
-    hide leaves less than a quarter of the region, or when the search up or down leaves the
-    picture. A pitch warps the picture a little and the sensor's noise is new: a box's front
-    knocked 1.8 degrees scored 0.37-0.49 at its shifted place and under 0.1 elsewhere (dev
-    seed 8's trial 45)."""
+    hide leaves less than a quarter of the region, or when fewer than half its rows (or 8)
+    stay in the picture through the search. A pitch warps the picture a little and the
+    sensor's noise is new: a box's front knocked 1.8 degrees scored 0.37-0.49 at its shifted
+    place and under 0.1 elsewhere (dev seed 8's trial 45)."""
     grey = to_grey(image).astype(np.float32)
     h, w = grey.shape
     x, y, bw, bh = box
+    top, bottom = max(0, max_rows - y), max(0, y + bh + max_rows - h)  # rows left out
+    if bh - top - bottom < max(8, bh / 2):
+        return math.nan
+    y, bh = y + top, bh - top - bottom
     # across, the search stops at the picture's sides (a region cut by the picture's edge
     # reaches it); down, it must reach max_rows both ways
     y0, y1, x0, x1 = y - max_rows, y + bh + max_rows, max(0, x - max_cols), \
@@ -123,6 +133,29 @@ def target_shift_rows(reference: np.ndarray, image: np.ndarray, box: tuple[int, 
     scores[~np.isfinite(scores)] = -1.0
     _, best, _, (_, row) = cv2.minMaxLoc(scores)
     return float(row - max_rows) if best >= min_score else math.nan
+
+
+def nearest_agreeing(disp: np.ndarray, min_area: int, agreement: Callable[[Target], float],
+                     limits: RereferenceLimits = RereferenceLimits(),
+                     tries: int = 4) -> tuple[Target, float]:
+    """The nearest object in disp (perception.nearest_object) whose two views do not
+    disagree, with its agreement (inputs.views_agree via agreement): a region scoring below
+    limits.agreement is a false one (flicker spoils one view: seed 11's trial 522 found
+    regions 8 px nearer than the target agreeing -0.01 to -0.09 while the target stood where
+    it was), and its pixels (its box's at its depth, within the larger of 1 px and its
+    spread) are left out before looking again, up to `tries` times. A region without texture
+    (NaN) is no proof of a false one and is returned as found (rereference_fault refuses it).
+    HostError when no object is left."""
+    disp = disp.copy()
+    for _ in range(tries):
+        found = nearest_object(disp, min_area)
+        score = agreement(found)
+        if not score < limits.agreement:  # agrees, or NaN: no texture to tell
+            return found, score
+        x, y, w, h = found.bbox
+        part = disp[y:y + h, x:x + w]
+        part[part >= found.disparity - max(1.0, found.spread)] = np.nan
+    raise HostError(f"every nearest object's two views disagree ({tries} tried)")
 
 
 def rereference_fault(old_floor: Floor | None, floor: Floor, shift_rows: float, old: Target,

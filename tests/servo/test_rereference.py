@@ -3,13 +3,19 @@ picture's shift (host/servo/rereference.py): constructed targets, floors and map
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable
+
 import cv2
 import numpy as np
+import pytest
 
+from host.errors import HostError
 from host.servo.perception import Floor, Target
 from host.servo.rereference import (
     fill_hidden,
     horizon_row,
+    nearest_agreeing,
     rereference_fault,
     target_shift_rows,
 )
@@ -165,3 +171,55 @@ def test_a_target_measured_at_its_new_depth_just_before_the_knock_is_a_re_refere
     farther = Target(19.9, 9166, (26, 56, 73, 134), 0.16)
     assert rereference_fault(OLD_FLOOR, floor, -15.1, old, farther, 0.94,
                              last=21.48).startswith("the nearest object is at 19.90 px")
+
+
+def test_a_target_near_the_pictures_bottom_is_matched_on_the_rows_that_stay_in_it():
+    """Seed 11's trial 755: a box standing on the floor, its region reaching 17 rows from the
+    picture's bottom, the picture moved 14 rows down and searched 18 rows: the search ran
+    past the bottom and the target was NaN (the re-reference refused). Its rows that stay in
+    the picture find it; a region with fewer than half its rows left is still NaN, and a box
+    that is not there any more still is not found."""
+    rng = np.random.default_rng(5)
+    scene = cv2.GaussianBlur(rng.uniform(0, 255, (240, 320)).astype(np.float32), (5, 5), 1.5)
+    moved = (np.roll(scene, 14, axis=0) + rng.normal(0, 3, scene.shape)).astype(np.uint8)
+    assert target_shift_rows(scene, moved, (30, 64, 57, 159), 18) == 14
+    up = (np.roll(scene, -12, axis=0) + rng.normal(0, 3, scene.shape)).astype(np.uint8)
+    assert target_shift_rows(scene, up, (30, 6, 57, 120), 16) == -12  # near the top
+    assert np.isnan(target_shift_rows(scene, moved, (30, 215, 57, 24), 18))  # 7 of 24 rows stay
+    other = rng.uniform(0, 255, (240, 320)).astype(np.uint8)
+    assert np.isnan(target_shift_rows(scene, other, (30, 64, 57, 159), 18))
+
+
+def _scene(*regions: tuple[tuple[int, int, int, int], float]) -> np.ndarray:
+    """A map (floor taken out: NaN) with rectangular regions (x, y, w, h) at disparities."""
+    disp = np.full((240, 320), np.nan, np.float32)
+    for (x, y, w, h), d in regions:
+        disp[y:y + h, x:x + w] = d
+    return disp
+
+
+def test_a_nearer_region_whose_views_disagree_is_passed_over():
+    """Seed 11's trial 522: after a knock, flicker made regions 8 px nearer than the target
+    whose two views disagree (-0.01 to -0.09); the re-reference took one as the nearest object
+    and refused ("the nearest object is at 31.12 px") with the target where it was. Passed
+    over, the target is found; a nearer object agreeing in both views (a box put down) or
+    without texture to tell is still the one found, and rereference_fault refuses it."""
+    target, phantom = ((22, 67, 89, 76), 17.5), ((150, 100, 40, 30), 25.5)
+
+    def scores(flicker: float) -> Callable[[Target], float]:
+        return lambda t: flicker if t.bbox[0] >= 150 else 0.95
+
+    disp = _scene(target, phantom)
+    found, agree = nearest_agreeing(disp, 1000, scores(-0.05))
+    assert found.bbox == target[0] and abs(found.disparity - 17.5) < 1e-6 and agree == 0.95
+    assert rereference_fault(OLD_FLOOR, _pitched(OLD_FLOOR, UP), UP, TARGET,
+                             Target(found.disparity, found.area, (22, 67, 89, 76), 0.1),
+                             agree) == ""
+    assert not np.isnan(disp).all() and np.nanmax(disp) == 25.5  # the map is left as it was
+    for real in (0.9, math.nan):  # a real box in front: found, and refused
+        box, agree = nearest_agreeing(disp, 1000, scores(real))
+        assert box.bbox == phantom[0] and box.disparity == 25.5
+        assert rereference_fault(OLD_FLOOR, _pitched(OLD_FLOOR, UP), UP, TARGET, box,
+                                 agree) != ""
+    with pytest.raises(HostError):  # nothing agrees: no object
+        nearest_agreeing(disp, 1000, lambda t: -0.05)
