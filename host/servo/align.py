@@ -16,6 +16,7 @@ import cv2
 import numpy as np
 
 MIN_PIXELS = 200  # fewer face pixels than this (hidden, cut by the view's edge): no refinement
+MAP_COLS = 4096  # the points sampled a row of the remap maps at a time (cv2.remap: < SHRT_MAX)
 
 
 def aligned_disparity(left: np.ndarray, right: np.ndarray, disp: np.ndarray,
@@ -42,9 +43,8 @@ def aligned_disparity(left: np.ndarray, right: np.ndarray, disp: np.ndarray,
     gradient = cv2.Sobel(rg, cv2.CV_32F, 1, 0, ksize=3) / 8
     d = d0
     for _ in range(iterations):
-        at = (xs - d).reshape(1, -1), ys.reshape(1, -1)
-        shifted = cv2.remap(rg, *at, cv2.INTER_CUBIC).ravel()
-        gx = cv2.remap(gradient, *at, cv2.INTER_CUBIC).ravel()
+        shifted = _sample(rg, xs - d, ys)
+        gx = _sample(gradient, xs - d, ys)
         den = float(gx @ gx)
         if den <= 0.0:
             return d0
@@ -55,6 +55,20 @@ def aligned_disparity(left: np.ndarray, right: np.ndarray, disp: np.ndarray,
         if abs(step) < 1e-4:
             break
     return d
+
+
+def _sample(image: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+    """image at the points (xs, ys) by cubic interpolation: cv2.remap takes maps of fewer than
+    SHRT_MAX columns, so the points go in rows of MAP_COLS (each point's value does not depend
+    on the map's shape)."""
+    n = len(xs)
+    rows = -(-n // MAP_COLS)
+    mx = np.zeros(rows * MAP_COLS, np.float32)
+    my = np.zeros(rows * MAP_COLS, np.float32)
+    mx[:n], my[:n] = xs, ys
+    out = cv2.remap(image, mx.reshape(rows, MAP_COLS), my.reshape(rows, MAP_COLS),
+                    cv2.INTER_CUBIC)
+    return np.asarray(out).ravel()[:n]
 
 
 def _grey(image: np.ndarray) -> np.ndarray:

@@ -65,3 +65,19 @@ def test_the_hidden_box_is_left_out() -> None:
     d = aligned_disparity(left, right, without_floor(disp, floor), target.bbox,
                           target.disparity, hide=(x - 5, y - 5, x + w + 5, y + h + 5))
     assert d == target.disparity
+
+
+def test_a_face_of_more_pixels_than_a_remap_row_holds_is_aligned() -> None:
+    """A near box at 640x480 covers more than SHRT_MAX (32767) face pixels: cv2.remap refuses a
+    map that wide, so the points are sampled in rows; the shift is still found."""
+    import cv2
+    rng = np.random.default_rng(7)
+    left = cv2.GaussianBlur(rng.integers(0, 256, (480, 640)).astype(np.float32), (0, 0), 2.0)
+    shift = 10.3  # right(x) = left(x + shift): the face at 10.3 px of disparity
+    m = np.float32([[1, 0, shift], [0, 1, 0]])
+    right = cv2.warpAffine(left, m, (640, 480), flags=cv2.INTER_CUBIC | cv2.WARP_INVERSE_MAP)
+    left8, right8 = (np.clip(v, 0, 255).astype(np.uint8) for v in (left, right))
+    disp = np.full((480, 640), 10.0, np.float32)
+    bbox = (100, 60, 400, 300)  # 120,000 pixels, ~110,000 after the erosion
+    d = aligned_disparity(left8, right8, disp, bbox, 10.0)
+    assert abs(d - shift) < 0.05, d
