@@ -42,6 +42,7 @@ from host.servo.clearance import (
     Body,
     Heading,
     depth_noise_m,
+    facing_shown,
     in_the_way,
     motion_heading,
     run_fault,
@@ -638,9 +639,10 @@ class Servo:
         place within its circle; standing (settled), a drift that closes within
         push_horizon_s (clearance.in_the_way). The heading is the one travelled
         (self.heading, within its spread); not known or too uncertain at the robot's range,
-        the controller's facing (clearance.motion_heading); a sighting that puts the body
-        inside a fixed object (a disc on a wall) is no robot's, and its probe is not stopped
-        by that object. Why the run ends, or ""."""
+        the controller's facing (clearance.motion_heading), for a drive or a reversed leg the
+        other way too until the travel shows that facing (clearance.facing_shown); a sighting
+        that puts the body inside a fixed object (a disc on a wall) is no robot's, and its
+        probe is not stopped by that object. Why the run ends, or ""."""
         est, c = self.estimator, self.controller
         if est.state is None or c is None or not self.cfg.fixed_check:
             return ""
@@ -676,9 +678,21 @@ class Servo:
         body = Body(cfg.half_width_m, cfg.half_length_m, cfg.block_margin_m + cfg.cell_m / 2)
         hit = run_fault(cells, s.z, s.x, cmd.left, cmd.right, h, spread, travel, body,
                         self.cfg.wheelbase_m)
+        what = "probe" if cmd.phase == Phase.PROBE else "reversed leg" if back else "drive"
+        if hit is None and cmd.phase != Phase.PROBE and not facing_shown(self.heading,
+                                                                         c.facing_away):
+            # facing the other way, it runs on until its travel shows the way (Heading.way),
+            # then stops within the same stopping distance
+            g = self.geometry
+            show = self.heading.way_sigmas * depth_noise_m(s.z, est.sigma_px, g.focal_px,
+                                                            g.baseline_m)
+            hit = run_fault(cells, s.z, s.x, cmd.left, cmd.right, h + math.pi, spread,
+                            travel + show, body, self.cfg.wheelbase_m)
+            if hit is not None:  # a facing the travel has not shown: it may be the other
+                return (f"{INTO_FIXED.format(what)} if it faces the other way (its facing "
+                        f"not yet shown by its travel; {hit:.2f} m on)")
         if hit is None:
             return ""
-        what = "probe" if cmd.phase == Phase.PROBE else "reversed leg" if back else "drive"
         return f"{INTO_FIXED.format(what)} ({hit:.2f} m on)"
 
     def _path_fault(self, frame: StereoFrame, cmd: Command) -> str:

@@ -13,7 +13,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from host.servo.clearance import Body, Heading, depth_noise_m, own_body, swept
+from host.servo.clearance import Body, Heading, depth_noise_m, facing_shown, own_body, swept
 from host.servo.controller import (
     LINE_BLOCKED,
     PUSHED,
@@ -298,6 +298,32 @@ def test_the_headings_spread_follows_the_depth_noise_at_its_range() -> None:
     assert near.value is not None and abs(near.value) < 1e-9 and near.spread < math.radians(8)
     far = run(2.95, 0.30)
     assert far.value is not None and far.spread < far.max_spread
+
+
+def test_the_way_a_robot_faces_is_shown_only_by_a_run_beyond_the_noise() -> None:
+    """Seed 12 trial 246's probe at 3 m: the estimate rose 6.6 cm in 0.2 s under backward
+    duty (sightings err together for a few frames), the truth moved 1 cm the other way; that
+    shows no way, though beyond three of its noise there (1.65 cm). A forward run of 0.6 s
+    whose depth falls 12 cm (beyond three of 3.5 cm) shows the robot faces the camera; one
+    whose depth falls 5 cm (within that noise) shows nothing; a spin forgets it, standing
+    keeps it."""
+    noise = 0.035
+    h = Heading()
+    for k in range(7):  # 0.2 s of the probe: 6.6 cm against backing
+        h.update(0.5 + 0.033 * k, 2.90 + 0.011 * k, -0.08, -300, -300, 0.0165)
+    assert h.way == 0 and not facing_shown(h, False) and not facing_shown(h, True)
+    h = Heading()
+    for k in range(7):
+        h.update(1.0 + 0.1 * k, 2.98 - 0.02 * k, -0.08, 540, 660, noise)
+    h.update(1.7, 2.86, -0.08, 0, 0, noise)
+    assert h.value is None and h.way == -1
+    assert facing_shown(h, False) and not facing_shown(h, True)
+    h.update(1.8, 2.86, -0.08, 300, -300, noise)
+    assert h.way == 0
+    h = Heading()
+    for k in range(7):
+        h.update(1.0 + 0.1 * k, 2.98 - 0.05 * k / 6, -0.08, 540, 660, noise)
+    assert h.way == 0
 
 
 def test_a_run_sweeps_the_bodys_rectangle_turned_by_its_heading() -> None:

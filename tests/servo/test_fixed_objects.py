@@ -246,3 +246,40 @@ def test_a_drive_past_a_boxs_end_with_room_for_the_body_is_driven(scene: Servo) 
     servo = _at(scene, 1.95, 0.14, 180, vz=-0.25)
     servo.controller.facing_away = False  # type: ignore[union-attr]
     assert _path(servo, drive).startswith(INTO_FIXED.format("drive"))
+
+
+
+def test_a_drive_on_a_facing_its_travel_has_not_shown_is_checked_the_other_way_too(
+        scene: Servo) -> None:
+    """Seed 12 trial 246: at 3 m the probe's verdict (the sign of a move within the noise) had
+    the robot face the camera; it faced the back wall 20 cm behind. No heading learnt at that
+    range, its drive "toward the camera" was checked that way alone (+-5 degrees); it went 10
+    cm toward the wall before the motion check turned it round, and the turn's circle hit the
+    wall. Now, its facing not shown by its travel, the drive is checked the other way too, on
+    for as far as the travel needs to show the way: 25 cm short of the wall's cells (3.19 m
+    here; 246 stood 23 cm short of them, at 3.17 m), it is not driven (checked that way
+    within its stopping distance alone, it would be). Shown by a straight run of 0.6 s
+    whose depth fell 12 cm under forward duty (beyond three of the noise there: 3.5 cm a
+    sighting at 0.1 px), or 19 cm nearer the camera, it is driven; a run as long whose depth fell
+    5 cm (within that noise) shows nothing."""
+    drive = Command(543, 657, Phase.DRIVE, 1.8)
+    z = 2.94
+
+    def facing_camera(z: float, fell_m: float | None) -> Servo:
+        servo = _at(scene, z, -0.087, None)
+        servo.controller.facing_away = False  # type: ignore[union-attr]
+        g = scene.geometry
+        noise = depth_noise_m(z, scene.estimator.sigma_px, g.focal_px, g.baseline_m)
+        if fell_m is not None:  # a forward run ending here (a spread too wide for a heading)
+            for k in range(7):
+                servo.heading.update(9.0 + 0.1 * k, z + fell_m * (6 - k) / 6, -0.087, 500, 500,
+                                     noise)
+            servo.heading.update(9.7, z, -0.087, 0, 0, noise)
+        return servo
+
+    why = _path(facing_camera(z, None), drive)
+    assert why.startswith(INTO_FIXED.format("drive")) and "other way" in why, why
+    assert _path(facing_camera(z, 0.12), drive) == ""
+    assert scene.heading.value is None  # shown without a heading learnt
+    assert _path(facing_camera(z, 0.05), drive).startswith(INTO_FIXED.format("drive"))
+    assert _path(facing_camera(z - 0.19, None), drive) == ""
