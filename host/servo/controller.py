@@ -281,25 +281,6 @@ class Controller:
         horizon = cfg.push_horizon_s if seen else cfg.unseen_horizon_s
         return toward > 0 and gap < toward * horizon
 
-    def unseen_rate(self, lateral: float, vx: float, vz: float, heading: float,
-                    spread: float) -> float:
-        """The sideways rate (m/s) to carry over unseen_horizon_s from one measured while the
-        robot was driven (vx, vz; heading in rad, within spread): its own motion along the
-        heading (x' = z' tan heading) ends with the wheels' run-down once it is stopped, a
-        push goes on. Within the spread, the heading that leaves the most toward the object;
-        never more toward it than the rate measured (a heading that is not known well enough
-        to explain the rate leaves it as it is)."""
-        if self.keep_out is None:
-            return vx
-        toward = -1.0 if lateral > self.keep_out[1] else 1.0
-        measured = toward * vx
-        headings = (heading - spread, heading, heading + spread)
-        if measured <= 0 or min(abs(math.cos(h)) for h in headings) < 0.5 or len(
-                {math.cos(h) > 0 for h in headings}) > 1:
-            return vx  # moving away, or a heading near sideways: tan explains nothing
-        push = max(toward * (vx - vz * math.tan(h)) for h in headings)
-        return toward * min(measured, max(0.0, push))
-
     def overlaps(self, lateral: float | None, margin: float = 0.0) -> bool:
         """Whether the robot's body at this lateral position comes within margin of the
         object's extent."""

@@ -622,14 +622,8 @@ class Servo:
         s = est.state
         if not cmd.is_stop and cmd.phase in (Phase.FIND, Phase.SEARCH) and c.sweeps(s.z, s.x):
             return TURN_BLOCKED
-        # unseen for a few frames (seen, the controller's hold watches the drift itself); a
-        # rate seen while driven is partly its own motion, gone after the run-down (push)
-        dt, vx, run = t - s.t, s.vx, est.cfg.run_down_s
-        if self.heading.value is not None and (
-                self._still_since is None or s.t < self._still_since + run):
-            vx = c.unseen_rate(s.x, s.vx, s.vz, self.heading.value, self.heading.spread)
-        x = s.x + s.vx * min(dt, run) + vx * max(0.0, dt - run)
-        if dt > 0.1 and c.closing(x, vx, seen=False):
+        # unseen for a few frames (seen, the controller's hold watches the drift itself)
+        if t - s.t > 0.1 and c.closing(s.x + s.vx * (t - s.t), s.vx, seen=False):
             return DRIFTED
         return ""
 

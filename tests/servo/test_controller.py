@@ -151,36 +151,3 @@ def test_a_far_robot_off_its_lane_keeps_its_card_near_square(x0: float) -> None:
         worst = max(worst, math.degrees(math.acos(abs(math.cos(plant.theta)))))
     assert ctl.phase == "hold" and unseen == 0, (worst, unseen, plant.z)
     assert worst < 30.0 and abs(plant.x) < 0.03, (worst, plant.x)
-
-
-def _beside_the_object() -> Controller:
-    c = Controller(1.213)
-    c.keep_out = (-0.389, -0.178)  # seed 12 trial 213: the object's extent, the robot right of it
-    return c
-
-
-def test_a_driven_robots_own_sideways_motion_is_not_carried_as_a_drift_while_unseen() -> None:
-    """Seed 12 trial 213: the card lost while the robot drove at 0.109 m/s on a heading of -6.2
-    degrees (learnt within 2.4): its -11.5 mm/s sideways was its own motion (the true push was
-    3.5 mm/s) and stopped with the wheels; carried over the 6 s horizon it put the robot on
-    the object ("drifting sideways ... unseen"), 7.6 cm from it with 16 s to go at the push."""
-    c = _beside_the_object()
-    x, vx, vz = -0.0234, -0.0115, 0.1087
-    assert c.closing(x, vx, seen=False)  # the rate as measured: the stop the campaign made
-    rate = c.unseen_rate(x, vx, vz, math.radians(-6.2), math.radians(2.4))
-    assert -0.0115 < rate < -0.004  # the push the heading's spread leaves, toward the object
-    assert not c.closing(x, rate, seen=False)
-
-
-def test_a_real_sideways_drift_while_unseen_still_stops() -> None:
-    """The same rate with the robot driven straight (its heading within 2.4 degrees of the
-    depth axis): the motion cannot be its own, it is a push, and it is carried."""
-    c = _beside_the_object()
-    x, vx, vz = -0.0234, -0.0115, 0.1087
-    rate = c.unseen_rate(x, vx, vz, 0.0, math.radians(2.4))
-    assert rate == pytest.approx(vx)
-    assert c.closing(x, rate, seen=False)
-    # facing the camera (driving toward it) the same
-    assert c.unseen_rate(x, vx, -vz, math.pi, math.radians(2.4)) == pytest.approx(vx)
-    # a heading too uncertain (or across the depth axis) explains nothing
-    assert c.unseen_rate(x, vx, vz, math.radians(-6.2), math.radians(70)) == vx
