@@ -151,3 +151,31 @@ def test_a_far_robot_off_its_lane_keeps_its_card_near_square(x0: float) -> None:
         worst = max(worst, math.degrees(math.acos(abs(math.cos(plant.theta)))))
     assert ctl.phase == "hold" and unseen == 0, (worst, unseen, plant.z)
     assert worst < 30.0 and abs(plant.x) < 0.03, (worst, plant.x)
+
+
+def test_a_push_in_the_travels_heading_is_still_carried_while_the_card_is_unseen() -> None:
+    """Driven straight away from the camera at 0.1 m/s beside the object under a 1 cm/s push
+    toward it, the card lost: the heading learnt from the travel leans 5.7 degrees toward the
+    object, the push's own share (clearance.Heading is the travel's chord), so the sideways
+    rate cannot be taken for the robot's own motion by that heading. The rate is carried and
+    the run ends ("drifting ... unseen"): 5.3 cm from the 2 cm margin, 6 cm in the 6 s."""
+    from host.servo.clearance import Heading
+    from host.servo.controller import DRIFTED, Command
+    from host.servo.estimator import _State
+    from host.servo.phase import Phase
+    from host.sim.run import Setup, simulation
+
+    with simulation(Setup(start_z_m=2.7, start_x_m=-0.1, seed=3)) as sim:
+        servo = sim.servo
+        c = servo.controller
+        assert c is not None
+        c.target_m, c.keep_out = 1.213, (-0.389, -0.178)  # seed 12 trial 213's object
+        t, z, x, vz, vx = 10.0, 1.2, -0.0234, 0.1, -0.01
+        servo.heading = Heading()
+        for k in range(15):  # the last second's travel: along the depth axis and the push
+            back = 1.0 - k / 14
+            servo.heading.update(t - back, z - vz * back, x - vx * back, 300, 300, 0.002)
+        assert servo.heading.value == pytest.approx(math.atan2(vx, vz), abs=0.01)
+        servo.estimator.state = _State(t, z, x, vz, vx)
+        servo._still_since = t + 0.03  # stopped as the card went
+        assert servo._spin_fault(t + 0.2, Command(0, 0, Phase.WAIT, None)) == DRIFTED
