@@ -3,9 +3,15 @@ imports and its saves hold msvcrt's lock, seen here through a stand-in msvcrt on
 
 from __future__ import annotations
 
+import errno
+import importlib.util
 import subprocess
 import sys
+import types
+from collections.abc import Callable
 from pathlib import Path
+
+import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -52,3 +58,53 @@ def test_the_cache_lock_imports_without_fcntl_and_locks_with_msvcrt(tmp_path: Pa
     saved, locked, unlocked = run.stdout.rsplit(" ", 2)
     assert saved == "('code a', 'code b')"
     assert int(locked) >= 4 and int(locked) == int(unlocked)
+
+
+def _windows_module(monkeypatch: pytest.MonkeyPatch,
+                    locking: Callable[[int, int, int], None]) -> types.ModuleType:
+    """host/stereo/numba_cache.py loaded as on Windows, its msvcrt.locking the given stand-in."""
+    msvcrt = types.ModuleType("msvcrt")
+    msvcrt.LK_LOCK, msvcrt.LK_UNLCK, msvcrt.locking = 1, 0, locking  # type: ignore[attr-defined]
+    monkeypatch.setitem(sys.modules, "msvcrt", msvcrt)
+    monkeypatch.setitem(sys.modules, "fcntl", None)
+    monkeypatch.setattr(sys, "platform", "win32")
+    spec = importlib.util.spec_from_file_location("numba_cache_win",
+                                                  ROOT / "host/stereo/numba_cache.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_windows_lock_waits_out_a_held_lock_and_raises_any_other_error(
+        monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    """LK_LOCK's EDEADLOCK (10 tries failed: another process compiles) is waited out; a bad
+    descriptor or no access is raised at once, never retried for ever."""
+    tries: list[int] = []
+
+    def held_twice(fd: int, mode: int, nbytes: int) -> None:
+        tries.append(mode)
+        if len(tries) <= 2:
+            raise OSError(errno.EDEADLOCK, "Resource deadlock avoided")
+
+    module = _windows_module(monkeypatch, held_twice)
+    with open(tmp_path / "lock", "a") as f:
+        module._lock(f)
+    assert tries == [1, 1, 1]
+
+    def bad(fd: int, mode: int, nbytes: int) -> None:
+        tries.append(mode)
+        if len(tries) > 10:
+            raise AssertionError("retried a permanent error")
+        raise OSError(errno.EBADF, "Bad file descriptor")
+
+    tries.clear()
+    module = _windows_module(monkeypatch, bad)
+    with open(tmp_path / "lock", "a") as f:
+        try:
+            module._lock(f)
+        except OSError as e:
+            assert e.errno == errno.EBADF
+        else:
+            raise AssertionError("no error")
+    assert tries == [1]

@@ -3,6 +3,7 @@ importing host.stereo (every process that compiles one of our kernels imports it
 
 from __future__ import annotations
 
+import errno
 import functools
 import os
 import sys
@@ -15,12 +16,13 @@ if sys.platform == "win32":
 
     def _lock(f: IO[str]) -> None:
         f.seek(0)  # msvcrt locks bytes from the file's position: byte 0 of the lock file
-        while True:  # LK_LOCK gives up after 10 tries a second apart; a compile can take longer
-            try:
+        while True:  # LK_LOCK gives up after 10 tries a second apart (EDEADLOCK); a compile can
+            try:  # take longer. Any other error (a bad descriptor, no access) is raised
                 msvcrt.locking(f.fileno(), msvcrt.LK_LOCK, 1)
                 return
-            except OSError:
-                continue
+            except OSError as e:
+                if e.errno != errno.EDEADLOCK:
+                    raise
 
     def _unlock(f: IO[str]) -> None:
         f.seek(0)
