@@ -36,7 +36,8 @@ class SimRectifier(Rectifier):
     def __init__(self, calib: Calibration, source: Made) -> None:
         super().__init__(calib)
         self.source = source
-        self._rectified: dict[int, tuple[np.ndarray, np.ndarray]] = {}  # id: (bare, rectified)
+        self._rectified: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
+        # (side, id of the bare image): (bare, rectified with that side's maps)
         # per output row, the least and greatest source row of the maps; per column, the
         # same of the source columns (the 2x2 source pixels start there)
         self._bounds = [(m[..., 1].min(1), m[..., 1].max(1), m[..., 0].min(0), m[..., 0].max(0))
@@ -67,13 +68,15 @@ class SimRectifier(Rectifier):
         return out
 
     def _bare(self, side: int, bare: np.ndarray) -> np.ndarray:
-        """The bare image rectified, made once (kept with the image it is of)."""
-        kept = self._rectified.get(id(bare))
+        """The bare image rectified with the side's maps, made once (kept with the image it is
+        of, by side: one array shared by the two sides is rectified once for each)."""
+        key = (side, id(bare))
+        kept = self._rectified.get(key)
         if kept is None or kept[0] is not bare:
             if len(self._rectified) >= self.MAX_BARE:
                 self._rectified.clear()
             m1, m2 = self._maps[side]
-            kept = self._rectified[id(bare)] = (bare, cv2.remap(bare, m1, m2, cv2.INTER_LINEAR))
+            kept = self._rectified[key] = (bare, cv2.remap(bare, m1, m2, cv2.INTER_LINEAR))
         return kept[1]
 
 

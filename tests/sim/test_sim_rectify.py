@@ -80,3 +80,14 @@ def rect_hit(rect: SimRectifier, box: tuple[int, int, int, int]
              ) -> tuple[int, int, int, int] | None:
     from host.sim.rectify import _hit
     return _hit(rect._bounds[0], rect._maps[0][0], box)
+
+
+def test_a_bare_image_shared_by_the_two_sides_is_rectified_with_each_sides_maps() -> None:
+    """The rectified bare images are kept by side: one array given for both sides (a renderer
+    that shared it) gives each side its own maps' image, as the Rectifier does."""
+    calib = _calibration((320, 240), LENS, 4)
+    rect = SimRectifier(calib, source=None)  # type: ignore[arg-type]  # _bare needs no source
+    bare = np.random.default_rng(2).integers(0, 256, (240, 320), dtype=np.uint8)
+    plain = Rectifier(calib)(StereoFrame(bare, bare, 0.0, 0.0))
+    assert np.array_equal(rect._bare(0, bare), plain.left)
+    assert np.array_equal(rect._bare(1, bare), plain.right)
