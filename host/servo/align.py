@@ -15,6 +15,8 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
+from host.stereo.grey import to_grey
+
 MIN_PIXELS = 200  # fewer face pixels than this (hidden, cut by the view's edge): no refinement
 MAP_COLS = 4096  # the points sampled a row of the remap maps at a time (cv2.remap: < SHRT_MAX)
 
@@ -37,7 +39,7 @@ def aligned_disparity(left: np.ndarray, right: np.ndarray, disp: np.ndarray,
     rows, cols = np.nonzero(cv2.erode(face, kernel))
     if len(rows) < MIN_PIXELS:
         return d0
-    lg, rg = _grey(left), _grey(right)
+    lg, rg = (to_grey(v).astype(np.float32) for v in (left, right))
     ys, xs = (rows + y).astype(np.float32), (cols + x).astype(np.float32)
     lp = lg[rows + y, cols + x]
     gradient = cv2.Sobel(rg, cv2.CV_32F, 1, 0, ksize=3) / 8
@@ -69,8 +71,3 @@ def _sample(image: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
     out = cv2.remap(image, mx.reshape(rows, MAP_COLS), my.reshape(rows, MAP_COLS),
                     cv2.INTER_CUBIC)
     return np.asarray(out).ravel()[:n]
-
-
-def _grey(image: np.ndarray) -> np.ndarray:
-    g = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY) if image.ndim == 3 else image
-    return g.astype(np.float32)

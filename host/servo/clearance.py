@@ -59,6 +59,16 @@ def own_body(cells: np.ndarray, z: float, x: float, own_m: float, centre_m: floa
     return near
 
 
+def _arc(s: np.ndarray, h0: float, curvature: float
+         ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The heading and the (z, x) offset from the start after each distance s along an arc of
+    this curvature (1/m) that starts on heading h0 (straight below 1e-6/m)."""
+    h = h0 + curvature * s
+    if abs(curvature) > 1e-6:
+        return h, (np.sin(h) - math.sin(h0)) / curvature, (math.cos(h0) - np.cos(h)) / curvature
+    return h, s * math.cos(h0), s * math.sin(h0)
+
+
 def in_the_way(cells: np.ndarray, z: float, x: float, heading: float | None, travel_m: float,
                radius_m: float, spread: float = 0.0, curvature: float = 0.0,
                step_m: float = 0.01) -> float | None:
@@ -83,12 +93,7 @@ def in_the_way(cells: np.ndarray, z: float, x: float, heading: float | None, tra
         return None
     for h0 in np.linspace(heading - spread, heading + spread, 1 + 2 * int(spread > 0)
                           + 2 * int(spread > math.radians(5))):
-        h = h0 + curvature * s
-        if abs(curvature) > 1e-6:
-            pz = (np.sin(h) - math.sin(h0)) / curvature
-            px = (math.cos(h0) - np.cos(h)) / curvature
-        else:
-            pz, px = s * math.cos(h0), s * math.sin(h0)
+        _, pz, px = _arc(s, h0, curvature)
         d = np.hypot(dz[ahead, None] - pz[None], dx[ahead, None] - px[None])
         inside = d < radius_m
         if inside.any():
@@ -136,12 +141,7 @@ def swept(cells: np.ndarray, z: float, x: float, heading: float, travel_m: float
     best: float | None = None
     for h0 in np.linspace(heading - spread, heading + spread,
                           1 + 2 * math.ceil(spread / math.radians(2.5))):
-        h = h0 + curvature * s
-        if abs(curvature) > 1e-6:
-            pz = (np.sin(h) - math.sin(h0)) / curvature
-            px = (math.cos(h0) - np.cos(h)) / curvature
-        else:
-            pz, px = s * math.cos(h0), s * math.sin(h0)
+        h, pz, px = _arc(s, h0, curvature)
         rz, rx = dz - pz[None], dx - px[None]
         along = rz * np.cos(h)[None] + rx * np.sin(h)[None]
         across = rx * np.cos(h)[None] - rz * np.sin(h)[None]

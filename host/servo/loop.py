@@ -352,12 +352,11 @@ class Servo:
                                        (g.cy + 0.5) / k - 0.5)
         self._lane_reference = self._lane_map(self.reference_map)
         self.tracker = TargetTracker(target, min_area, self.cfg.tracker)
+        clean = without_floor(self.reference_map, self.floor)
         # the face's two views aligned: the map's median is pixel-locked (align.py)
         self.controller = Controller(self.geometry.depth_m(aligned_disparity(
-            f.left, f.right, without_floor(self.reference_map, self.floor), target.bbox,
-            target.disparity)), self.control)
-        self.controller.keep_out = self._extent(
-            object_extent(without_floor(self.reference_map, self.floor), target))
+            f.left, f.right, clean, target.bbox, target.disparity)), self.control)
+        self.controller.keep_out = self._extent(object_extent(clean, target))
         self.controller.fixed = fixed_cells(self.reference_map, self.geometry,
                                             camera_height_m=self.camera_height_m,
                                             cell_m=self.control.cell_m)
