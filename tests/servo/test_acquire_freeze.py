@@ -134,3 +134,24 @@ def test_a_marker_gone_before_the_measure_is_done_is_found_again() -> None:
     assert acq.phase == Phase.MEASURE
     orders = [acq.update(0.033 * i, None, None) for i in range(2, 150)]
     assert any(o.phase == "find" and o.left == -o.right != 0 for o in orders)
+
+
+def test_a_far_probe_calls_the_facing_on_its_move_not_on_a_jump_of_its_sightings() -> None:
+    """Closed loop, seed 12's trial 246 (the reported campaign's one unsafe trial): started 3.00
+    m deep facing away, 20 cm from the back wall; its probe backed it 0.5 cm toward the camera
+    while its sightings jumped 7.7 cm the other way (0.23 px at 8.6 px), and it said "faces the
+    camera". Now the first leg shows nothing beyond the noise there, the way back (forward)
+    shows the facing: away, as the world has it."""
+    import math
+
+    from host.sim.trials import trial_setup
+    from host.stereo.params import MatcherParams
+
+    with simulation(trial_setup(12, 246, (320, 240), MatcherParams()), reference=True) as sim:
+        away = math.cos(sim.world.robot.theta) > 0
+        acq = sim.servo.acquisition
+        while sim.source.t < 8.0 and not sim.servo.stop_reason and not acq.done:
+            sim.step()
+            acq = sim.servo.acquisition
+        assert away and acq.facing_away is not False, "a jump of the sightings taken for a move"
+        assert acq.done and acq.facing_away is True, (sim.servo.stop_reason, sim.servo.notes)
