@@ -8,10 +8,15 @@ way the robot faces by what a short probe move does (a pure state machine, one c
              the marker unseen find_wait_s before they are in: find again
     probe    both wheels at probe_duty (raised by probe_step every probe_step_s), forward or
              backward (direction: the way the robot must go if it faces away), until
-             the marker has moved probe_m in depth (and three times its noise, the median of
-             the last five sightings against the first five's): the way it faces follows
-             from the sign of that move (at probe_s, from the sign of the move so far);
-             nothing moved by probe_s: the run stops with that reason; the marker unseen for
+             the marker has moved probe_m in depth and three times a sighting's noise there
+             (the measure's, at least floor_px in disparity: far sightings err together for
+             frames on end), the median of the last five sightings against the first five's:
+             the way it faces follows from the sign of that move; nothing moved by probe_s:
+             the run stops with that reason; moved within the noise by probe_s (far away):
+             the second leg, back the other way through the start and as far beyond it
+             (back_factor times the first's time), decides on its own move beyond the noise,
+             else the run stops (UNSHOWN), never on the sign of a move within the noise
+             (seed 12's trial 246 at 3 m); the marker unseen for
              probe_gap_s (the robot stands): the probe's clock stops meanwhile, but for the
              gap's first run_down_s (the last drive's reaction and run-down);
              a probe started again (after a stale frame, a knock) runs within what is left

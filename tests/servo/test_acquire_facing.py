@@ -62,7 +62,7 @@ def test_a_probe_whose_move_stays_within_the_noise_stops_named() -> None:
     assert acq.facing_away is None and not acq.done, acq.facing_away
     assert acq.fault.startswith(UNSHOWN.split(":")[0]), acq.fault
     first_leg = max(truth) - 3.0  # backed away from the camera, then forward through the start
-    assert 0.02 < first_leg and 3.0 - min(truth) <= first_leg + 0.01, (min(truth), max(truth))
+    assert first_leg > 0.02 and 3.0 - min(truth) <= first_leg + 0.01, (min(truth), max(truth))
 
 
 def test_a_near_probe_decides_on_its_first_leg_as_before() -> None:
