@@ -99,6 +99,7 @@ class Estimator:
         self._cmd: tuple[float, int, int] | None = None  # the command in force since t
         self._outside_since: float | None = None
         self._stopped_since: float | None = None  # told to stand since (s)
+        self._driven_rate = False  # the state's rate was learnt while the robot was driven
         self._segment: list[tuple[float, float, float]] = []  # (t, z, x) while driven one way
         self._segment_cmd: tuple[int, bool] = (0, False)  # its direction, duty >= still
         self._segment_t0 = 0.0
@@ -129,6 +130,20 @@ class Estimator:
             self._stopped_since = None
         elif self._stopped_since is None:
             self._stopped_since = t
+        self._run_down(t)
+
+    def _run_down(self, t: float) -> None:
+        """Told to stand for run_down_s, the depth rate a drive gave the state is spent: the
+        state's depth moves on to where that run-down took it and its rate is dropped (kept,
+        the rate ran on in the checks for seconds after a stop, the drive's own motion taken
+        for a drift). The lateral rate stays: a push learnt while driven goes on."""
+        st = self.state
+        if st is None or not self._driven_rate or self._stopped_since is None \
+                or t - self._stopped_since < self.cfg.run_down_s:
+            return
+        st.z = self.predicted(t)[0]
+        st.vz = 0.0
+        self._driven_rate = False
 
     def _account(self, t: float) -> None:
         """Add the command in force since its time up to t to the travel allowed."""
@@ -215,6 +230,8 @@ class Estimator:
             nz, nx = self.noise_m(z, x)
             standing = self._stopped_since is not None and \
                 s.t - self._stopped_since >= cfg.run_down_s
+            if not standing:
+                self._driven_rate = True
             az, bz = gains(nz, cfg.stand_accel_mps2 if standing else cfg.accel_mps2, dt)
             ax, bx = gains(nx, cfg.stand_accel_mps2 if standing else cfg.lateral_accel_mps2, dt)
             rz, rx = z - zp, x - xp
@@ -237,6 +254,7 @@ class Estimator:
         self.state = None
         self._ratios.clear()
         self._outside_since = None
+        self._driven_rate = False
         self._segment.clear()
 
     # ---------------------------------------------------------------------- motion check
