@@ -67,8 +67,8 @@ test-setup: venv system-deps browser-deps platformio lint typecheck test-firmwar
 # built here beside the warm step; pytest's own build (tests/conftest.py) then finds them up to
 # date. A missing AVR toolchain is not an error here: the tests skip, saying so
 test-firmware: system-deps
-	-@$(MAKE) -s -C firmware/atmega328
-	-@$(MAKE) -s -C firmware/atmega328 TEST_HANG=1
+	-@$(MAKE) -s -C firmware/atmega328 >/dev/null
+	-@$(MAKE) -s -C firmware/atmega328 TEST_HANG=1 >/dev/null
 
 lint: $(BIN)/.installed
 	$(BIN)/ruff check host tools bench tests
