@@ -10,19 +10,26 @@ DATA ?= $(abspath ../shared/data)
 # tests and benchmarks find the Middlebury scenes through this variable
 export STEREO_SERVO_DATA ?= $(if $(wildcard $(DATA)/middlebury/index.json),$(DATA),)
 
-.PHONY: demo test test-setup lint typecheck bench venv system-deps browser-deps platformio protocol firmware flash mutants fuzz clean
+.PHONY: demo test test-setup test-firmware lint typecheck bench venv system-deps browser-deps platformio protocol firmware flash mutants fuzz clean
 
-$(BIN)/.installed: pyproject.toml
+# the install in two steps: the package with its own dependencies first, which is what the warm
+# step needs, then the test and Ray extras (most of the download: Ray, playwright, mypy, ruff),
+# which make -j2 fetches while the warm step compiles
+$(BIN)/.core: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
+	$(BIN)/pip install --quiet --disable-pip-version-check -e .
+	touch $@
+
+$(BIN)/.installed: $(BIN)/.core
 	$(BIN)/pip install --quiet --disable-pip-version-check -e '.[test,ray]'
 	touch $@
 
 # numba compiles now (2 processes), not in the user's first run
-$(BIN)/.warmed: $(BIN)/.installed
+$(BIN)/.warmed: $(BIN)/.core
 	$(BIN)/python -m host.warm
 	touch $@
 
-venv: $(BIN)/.warmed
+venv: $(BIN)/.installed $(BIN)/.warmed
 
 system-deps:
 	@bash tools/system-deps.sh
@@ -52,9 +59,16 @@ TEST_WORKERS ?= 2
 # and the checks; make test-setup alone runs them one after the other
 test:
 	$(MAKE) -j2 test-setup
-	$(BIN)/python -m pytest -n $(TEST_WORKERS) --dist loadfile --durations=20
+	$(BIN)/python -m pytest -n $(TEST_WORKERS) --dist loadfile --no-loadscope-reorder --durations=40
 
-test-setup: venv system-deps browser-deps platformio lint typecheck
+test-setup: venv system-deps browser-deps platformio lint typecheck test-firmware
+
+# the firmware ELFs the simavr tests load (the normal build and the one that hangs on demand),
+# built here beside the warm step; pytest's own build (tests/conftest.py) then finds them up to
+# date. A missing AVR toolchain is not an error here: the tests skip, saying so
+test-firmware: system-deps
+	-@$(MAKE) -s -C firmware/atmega328 >/dev/null
+	-@$(MAKE) -s -C firmware/atmega328 TEST_HANG=1 >/dev/null
 
 lint: $(BIN)/.installed
 	$(BIN)/ruff check host tools bench tests

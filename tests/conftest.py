@@ -160,10 +160,23 @@ def pytest_ignore_collect(collection_path: Path, config) -> bool | None:
 
 
 def pytest_collection_modifyitems(config, items) -> None:
+    slow_files = set()
     for item in items:
         rel = Path(str(item.fspath)).resolve().relative_to(ROOT).as_posix()
         if _is_slow(rel, item.name):
             item.add_marker(pytest.mark.slow)
+            slow_files.add(rel)
+    if WORKER:  # pytest-xdist hands out whole files in this order (make test: no reordering)
+        items.sort(key=lambda item: _schedule_key(item, slow_files))
+
+
+def _schedule_key(item, slow_files: set[str]) -> int:
+    """Files holding a slow-tier test first (the closed-loop, simavr and Ray files take minutes
+    with a few tests each), so that the two workers do not end with one of them running a long
+    file alone while the other idles; a stable sort keeps each file's tests together and in
+    their order."""
+    rel = Path(str(item.fspath)).resolve().relative_to(ROOT).as_posix()
+    return 0 if rel in slow_files else 1
 
 
 # ---- two workers side by side (pytest-xdist; make test runs -n 2 --dist loadfile) ----------
