@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
+from numba import njit
 
 from host.stereo.grey import to_grey
 
@@ -128,10 +129,75 @@ def find_discs(image: np.ndarray, min_radius: float = 2.5, max_radius: float = 8
 def _outlines(mask: np.ndarray, min_area: float) -> list[np.ndarray]:
     """The outer contours of the mask's blobs that could enclose min_area px: a textured scene
     leaves thousands of specks. A closed contour of n points (steps of at most sqrt 2 px)
-    encloses at most (n sqrt 2)^2 / (4 pi) px, so shorter ones are dropped unmeasured."""
-    contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    encloses at most (n sqrt 2)^2 / (4 pi) px, so shorter ones are dropped unmeasured; the
+    specks whose box find_discs would drop are cleared before the contours are traced
+    (_without_specks), which leaves the others' contours as they were."""
+    contours, _ = cv2.findContours(_without_specks(mask, min_area), cv2.RETR_EXTERNAL,
+                                   cv2.CHAIN_APPROX_NONE)
     shortest = math.sqrt(2 * math.pi * min_area)
     return [c for c in contours if c.shape[0] >= shortest]
+
+
+@njit(cache=True, inline="always")
+def _root(parent: np.ndarray, i: int) -> int:
+    while parent[i] != i:
+        parent[i] = parent[parent[i]]
+        i = parent[i]
+    return i
+
+
+@njit(cache=True)
+def _without_specks(mask: np.ndarray, min_area: float) -> np.ndarray:
+    """A copy of the mask (uint8, 0 or not) without its 8-connected blobs whose bounding box
+    (w, h px) has (w - 1)(h - 1) < min_area: find_discs drops their contours by that test
+    (an outer contour's box is its blob's), and clearing them changes no other contour: a
+    contour is traced round its own blob, and a blob inside one's hole has a smaller box,
+    so none is newly outermost. Labelled by runs of a row joined to the runs they touch in
+    the row above (a union-find): the contours of thousands of specks cost cv2.findContours
+    more than this."""
+    h, w = mask.shape
+    cap = h * ((w + 1) // 2) + 1
+    run_y = np.empty(cap, np.int32)
+    run_x0 = np.empty(cap, np.int32)
+    run_x1 = np.empty(cap, np.int32)  # exclusive
+    parent = np.empty(cap, np.int32)
+    n = 0
+    above0 = above1 = 0  # the runs of the row above: [above0, above1)
+    for y in range(h):
+        row = mask[y]
+        first = n
+        x = 0
+        while x < w:
+            if row[x] == 0:
+                x += 1
+                continue
+            x0 = x
+            while x < w and row[x] != 0:
+                x += 1
+            run_y[n], run_x0[n], run_x1[n], parent[n] = y, x0, x, n
+            for j in range(above0, above1):  # touching, diagonals included
+                if run_x1[j] >= x0 and run_x0[j] <= x:
+                    a, b = _root(parent, j), _root(parent, n)
+                    parent[max(a, b)] = min(a, b)
+            n += 1
+        above0, above1 = first, n
+    lo_x = np.full(n, w, np.int32)
+    hi_x = np.full(n, -1, np.int32)
+    lo_y = np.full(n, h, np.int32)
+    hi_y = np.full(n, -1, np.int32)
+    for i in range(n):
+        r = _root(parent, i)
+        parent[i] = r
+        lo_x[r] = min(lo_x[r], run_x0[i])
+        hi_x[r] = max(hi_x[r], run_x1[i] - 1)
+        lo_y[r] = min(lo_y[r], run_y[i])
+        hi_y[r] = max(hi_y[r], run_y[i])
+    out = mask.copy()
+    for i in range(n):
+        r = parent[i]
+        if (hi_x[r] - lo_x[r]) * (hi_y[r] - lo_y[r]) < min_area:
+            out[run_y[i], run_x0[i]:run_x1[i]] = 0
+    return out
 
 
 def _ring_and_disc(grey: np.ndarray, cx: float, cy: float, r: float
