@@ -144,8 +144,11 @@ class World:
         self.t += dt
         a = 1.0 - math.exp(-dt / m.tau_s)
         supply = max(0.5, 1.0 - f.sag_per_m * self.travelled_m)
-        t_left = self._wheel(duty_left, supply, f.gain[0], f.offset[0], self.traction[0])
-        t_right = self._wheel(duty_right, supply, f.gain[1], f.offset[1], self.traction[1])
+        # a wheel without duty: speed(0.0) is 0 and nothing slips (the robot holding)
+        t_left = (self._wheel(duty_left, supply, f.gain[0], f.offset[0], self.traction[0])
+                  if duty_left else 0.0 * f.gain[0] * self.traction[0])
+        t_right = (self._wheel(duty_right, supply, f.gain[1], f.offset[1], self.traction[1])
+                   if duty_right else 0.0 * f.gain[1] * self.traction[1])
         r.v_left += (t_left - r.v_left) * a
         r.v_right += (t_right - r.v_right) * a
         v = (r.v_left + r.v_right) / 2
