@@ -164,15 +164,20 @@ class Emulator:
             self._collect()
 
     def advance(self, ms: float) -> None:
-        """Move the clock on by ms, ticking the core every millisecond."""
+        """Move the clock on by ms, ticking the core every millisecond. (The simulation calls
+        this every simulated millisecond: the reset and the delivery are looked at only when
+        one is set or due, the same steps as calling them every millisecond.)"""
         with self.lock:
             end = self.now_ms + ms
+            inbound = self._inbound
             while self.now_ms < end:
-                self.now_ms = min(end, float(int(self.now_ms) + 1))
-                self._reset_due()
-                self._deliver()
-                if int(self.now_ms) != self._ticked_ms:
-                    self._ticked_ms = int(self.now_ms)
+                self.now_ms = now = min(end, float(int(self.now_ms) + 1))
+                if self.faults.reset_at_ms is not None:
+                    self._reset_due()
+                if inbound and inbound[0][0] <= now:
+                    self._deliver()
+                if int(now) != self._ticked_ms:
+                    self._ticked_ms = int(now)
                     self._core.tick(self._ticked_ms)
                 self._collect()
 

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
+from numba import njit
 
 from host.stereo.grey import to_grey
 
@@ -42,36 +43,127 @@ class MarkerPair:
 _OPEN = np.ones((2, 2), np.uint8)  # the opening that removes one-pixel specks of the mask
 
 
-def _p90(patch: np.ndarray) -> float:
-    """np.percentile(patch, 90) of a uint8 array, exactly (its linear interpolation between
-    the order statistics on each side), from the histogram instead of a partition."""
-    n = patch.size
-    q = (n - 1) * 0.9
-    lo = math.floor(q)
-    hi = min(lo + 1, n - 1)
-    order = np.cumsum(np.bincount(patch.ravel(), minlength=256))
-    a, b = (float(np.searchsorted(order, k, side="right")) for k in (lo, hi))
-    gamma = q - lo
-    diff = b - a
-    return b - diff * (1 - gamma) if gamma >= 0.5 else a + diff * gamma
-
-
 def _centroid(grey: np.ndarray, cx: float, cy: float, r: float) -> tuple[float, float]:
     """Darkness-weighted centroid within 1.3 r (the disc plus a band of ring), sub-pixel."""
+    u, v = _centroid_of(grey, cx, cy, r, (1.3 * r) ** 2)
+    return float(u), float(v)
+
+
+@njit(cache=True)
+def _centroid_of(grey: np.ndarray, cx: float, cy: float, r: float,
+                 reach2: float) -> tuple[float, float]:
+    """_centroid (reach2: (1.3 r) ** 2 as Python computes it) in one pass, with numpy's
+    arithmetic: the weights (the patch's 90th percentile less each level, at least 0, 0
+    outside the reach) in the patch's row order, summed as numpy sums them (_numpy_sum)."""
     h, w = grey.shape
     x0, x1 = max(0, int(cx - 1.3 * r) - 1), min(w, int(cx + 1.3 * r) + 2)
     y0, y1 = max(0, int(cy - 1.3 * r) - 1), min(h, int(cy + 1.3 * r) + 2)
     raw = grey[y0:y1, x0:x1]
-    weight = _p90(raw) - raw.astype(np.float64)
-    np.maximum(weight, 0.0, out=weight)
-    xs, ys = np.arange(x0, x1), np.arange(y0, y1)
-    inside = ((xs - cx) ** 2)[None, :] + ((ys - cy) ** 2)[:, None] <= (1.3 * r) ** 2
-    weight *= inside
-    total = weight.sum()
+    top = _p90_of(raw)
+    n = raw.size
+    weight = np.empty(n)
+    wx = np.empty(n)
+    wy = np.empty(n)
+    i = 0
+    for y in range(y0, y1):
+        dy = y - cy
+        for x in range(x0, x1):
+            dx = x - cx
+            wt = max(top - np.float64(grey[y, x]), 0.0)
+            if not dx * dx + dy * dy <= reach2:
+                wt = wt * 0.0
+            weight[i], wx[i], wy[i] = wt, wt * np.float64(x), wt * np.float64(y)
+            i += 1
+    total = _numpy_sum(weight)
     if total <= 0:
         return cx, cy
-    # the same products in the same contiguous arrays as with np.mgrid's grids: the same sums
-    return float((weight * xs).sum() / total), float((weight * ys[:, None]).sum() / total)
+    return _numpy_sum(wx) / total, _numpy_sum(wy) / total
+
+
+@njit(cache=True)
+def _p90_of(patch: np.ndarray) -> float:
+    """np.percentile(patch, 90) of a uint8 array, exactly (its linear interpolation between
+    the order statistics on each side), from the histogram instead of a partition."""
+    n = patch.size
+    q = (n - 1) * 0.9
+    lo = int(math.floor(q))
+    hi = min(lo + 1, n - 1)
+    counts = np.zeros(256, np.int64)
+    for y in range(patch.shape[0]):
+        for x in range(patch.shape[1]):
+            counts[patch[y, x]] += 1
+    a = b = -1
+    seen = 0
+    for level in range(256):  # the first level whose cumulative count passes lo (hi)
+        seen += counts[level]
+        if a < 0 and seen > lo:
+            a = level
+        if seen > hi:
+            b = level
+            break
+    gamma = q - lo
+    diff = float(b) - float(a)
+    return b - diff * (1 - gamma) if gamma >= 0.5 else a + diff * gamma
+
+
+@njit(cache=True)
+def _block_sum(a: np.ndarray, lo: int, n: int) -> float:
+    # numpy's pairwise sum of a[lo:lo + n], n <= 128 (numpy/_core/src/umath/loops_utils.h)
+    if n < 8:
+        res = 0.0
+        for i in range(lo, lo + n):
+            res += a[i]
+        return res
+    r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
+    r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
+    i = 8
+    while i < n - n % 8:
+        r0 += a[lo + i]
+        r1 += a[lo + i + 1]
+        r2 += a[lo + i + 2]
+        r3 += a[lo + i + 3]
+        r4 += a[lo + i + 4]
+        r5 += a[lo + i + 5]
+        r6 += a[lo + i + 6]
+        r7 += a[lo + i + 7]
+        i += 8
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < n:
+        res += a[lo + i]
+        i += 1
+    return res
+
+
+@njit(cache=True)
+def _numpy_sum(a: np.ndarray) -> float:
+    """a.sum() of a contiguous float64 array as numpy computes it (its identity 0.0 plus the
+    pairwise sum: runs over 128 split in two at a multiple of 8, each half summed so, the
+    two added): the same float to the last bit. The halving walked with a stack of frames
+    (numba's cache does not reload a recursive function)."""
+    start = np.empty(64, np.int64)
+    size = np.empty(64, np.int64)
+    stage = np.empty(64, np.int64)  # 0: left half next, 1: right half next, 2: both done
+    first = np.empty(64)  # the left half's sum
+    d, start[0], size[0], stage[0] = 0, 0, a.size, 0
+    got = 0.0  # the sum of the frame last finished
+    while d >= 0:
+        lo, n = start[d], size[d]
+        if n <= 128:
+            got = _block_sum(a, lo, n)
+            d -= 1
+            continue
+        half = n // 2 - (n // 2) % 8
+        if stage[d] == 2:
+            got = first[d] + got
+            d -= 1
+            continue
+        if stage[d] == 1:
+            first[d] = got
+        stage[d] += 1
+        lo2, n2 = (lo, half) if stage[d] == 1 else (lo + half, n - half)
+        d += 1
+        start[d], size[d], stage[d] = lo2, n2, 0
+    return 0.0 + got
 
 
 def find_discs(image: np.ndarray, min_radius: float = 2.5, max_radius: float = 80.0,
@@ -108,16 +200,9 @@ def find_discs(image: np.ndarray, min_radius: float = 2.5, max_radius: float = 8
             continue
         r = (w + h) / 4
         u, v = _centroid(grey, x + (w - 1) / 2, y + (h - 1) / 2, r)
-        ring_px, disc_px = _ring_and_disc(grey, u, v, r)
-        # printed: a uniform light ring round a uniform dark disc (texture is neither); the
-        # means first (exact from the integer sums), the deviations only if they pass
-        ring = _mean(ring_px) if ring_px.size else 0.0
-        disc = _mean(disc_px) if disc_px.size else 0.0
-        if ring - disc < 80:
-            continue
-        ring_sd = float(ring_px.astype(np.float64).std()) if ring_px.size else 255.0
-        disc_sd = float(disc_px.astype(np.float64).std()) if disc_px.size else 255.0
-        if max(ring_sd, disc_sd) > 0.2 * (ring - disc):
+        # printed: a uniform light ring round a uniform dark disc (texture is neither)
+        ring, disc, ring_sd, disc_sd = _ring_and_disc(grey, u, v, r)
+        if ring - disc < 80 or max(ring_sd, disc_sd) > 0.2 * (ring - disc):
             continue
         m = cv2.moments(c)
         aspect = math.sqrt(m["mu20"] / m["mu02"]) if m["mu02"] > 0 else 1.0
@@ -128,28 +213,128 @@ def find_discs(image: np.ndarray, min_radius: float = 2.5, max_radius: float = 8
 def _outlines(mask: np.ndarray, min_area: float) -> list[np.ndarray]:
     """The outer contours of the mask's blobs that could enclose min_area px: a textured scene
     leaves thousands of specks. A closed contour of n points (steps of at most sqrt 2 px)
-    encloses at most (n sqrt 2)^2 / (4 pi) px, so shorter ones are dropped unmeasured."""
-    contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    encloses at most (n sqrt 2)^2 / (4 pi) px, so shorter ones are dropped unmeasured; the
+    specks whose box find_discs would drop are cleared before the contours are traced
+    (_without_specks), which leaves the others' contours as they were."""
+    contours, _ = cv2.findContours(_without_specks(mask, min_area), cv2.RETR_EXTERNAL,
+                                   cv2.CHAIN_APPROX_NONE)
     shortest = math.sqrt(2 * math.pi * min_area)
     return [c for c in contours if c.shape[0] >= shortest]
 
 
+@njit(cache=True, inline="always")
+def _root(parent: np.ndarray, i: int) -> int:
+    while parent[i] != i:
+        parent[i] = parent[parent[i]]
+        i = parent[i]
+    return i
+
+
+@njit(cache=True)
+def _without_specks(mask: np.ndarray, min_area: float) -> np.ndarray:
+    """A copy of the mask (uint8, 0 or not) without its 8-connected blobs whose bounding box
+    (w, h px) has (w - 1)(h - 1) < min_area: find_discs drops their contours by that test
+    (an outer contour's box is its blob's), and clearing them changes no other contour: a
+    contour is traced round its own blob, and a blob inside one's hole has a smaller box,
+    so none is newly outermost. Labelled by runs of a row joined to the runs they touch in
+    the row above (a union-find): the contours of thousands of specks cost cv2.findContours
+    more than this."""
+    h, w = mask.shape
+    cap = h * ((w + 1) // 2) + 1
+    run_y = np.empty(cap, np.int32)
+    run_x0 = np.empty(cap, np.int32)
+    run_x1 = np.empty(cap, np.int32)  # exclusive
+    parent = np.empty(cap, np.int32)
+    n = 0
+    above0 = above1 = 0  # the runs of the row above: [above0, above1)
+    for y in range(h):
+        row = mask[y]
+        first = n
+        x = 0
+        while x < w:
+            if row[x] == 0:
+                x += 1
+                continue
+            x0 = x
+            while x < w and row[x] != 0:
+                x += 1
+            run_y[n], run_x0[n], run_x1[n], parent[n] = y, x0, x, n
+            for j in range(above0, above1):  # touching, diagonals included
+                if run_x1[j] >= x0 and run_x0[j] <= x:
+                    a, b = _root(parent, j), _root(parent, n)
+                    parent[max(a, b)] = min(a, b)
+            n += 1
+        above0, above1 = first, n
+    lo_x = np.full(n, w, np.int32)
+    hi_x = np.full(n, -1, np.int32)
+    lo_y = np.full(n, h, np.int32)
+    hi_y = np.full(n, -1, np.int32)
+    for i in range(n):
+        r = _root(parent, i)
+        parent[i] = r
+        lo_x[r] = min(lo_x[r], run_x0[i])
+        hi_x[r] = max(hi_x[r], run_x1[i] - 1)
+        lo_y[r] = min(lo_y[r], run_y[i])
+        hi_y[r] = max(hi_y[r], run_y[i])
+    out = mask.copy()
+    for i in range(n):
+        r = parent[i]
+        if (hi_x[r] - lo_x[r]) * (hi_y[r] - lo_y[r]) < min_area:
+            out[run_y[i], run_x0[i]:run_x1[i]] = 0
+    return out
+
+
 def _ring_and_disc(grey: np.ndarray, cx: float, cy: float, r: float
-                   ) -> tuple[np.ndarray, np.ndarray]:
-    """The grey levels (uint8, in row order) of the ring (1.2 r to 1.45 r from the centre) and
-    of the disc (within 0.7 r), from one window and one grid of squared distances."""
-    h, w = grey.shape
+                   ) -> tuple[float, float, float, float]:
+    """The mean grey level of the ring (1.2 r to 1.45 r from the centre) and of the disc
+    (within 0.7 r), and their standard deviations: 0 and 255 for one without pixels."""
     r0, r1, rd = 1.2 * r, 1.45 * r, 0.7 * r
+    ring, disc, ring_sd, disc_sd = _ring_and_disc_of(grey, cx, cy, r1, r0 * r0, r1 * r1,
+                                                     rd * rd)
+    return float(ring), float(disc), float(ring_sd), float(disc_sd)
+
+
+@njit(cache=True)
+def _ring_and_disc_of(grey: np.ndarray, cx: float, cy: float, r1: float, ring_lo2: float,
+                      ring_hi2: float, disc2: float) -> tuple[float, float, float, float]:
+    """_ring_and_disc with numpy's arithmetic: the pixels by squared distance from one window
+    in row order; a mean from the exact integer sum, a deviation as numpy's std computes it
+    (the squared differences from that mean summed as numpy sums them)."""
+    h, w = grey.shape
     x0, x1 = max(0, int(cx - r1) - 1), min(w, int(cx + r1) + 2)
     y0, y1 = max(0, int(cy - r1) - 1), min(h, int(cy + r1) + 2)
-    d2 = ((np.arange(x0, x1) - cx) ** 2)[None, :] + ((np.arange(y0, y1) - cy) ** 2)[:, None]
-    patch = grey[y0:y1, x0:x1]
-    return patch[(d2 >= r0 * r0) & (d2 <= r1 * r1)], patch[d2 <= rd * rd]
+    n = max(0, (y1 - y0) * (x1 - x0))
+    ring_px = np.empty(n, np.int64)
+    disc_px = np.empty(n, np.int64)
+    nr = nd = 0
+    for y in range(y0, y1):
+        dy = y - cy
+        for x in range(x0, x1):
+            dx = x - cx
+            d2 = dx * dx + dy * dy
+            if d2 >= ring_lo2 and d2 <= ring_hi2:
+                ring_px[nr] = grey[y, x]
+                nr += 1
+            if d2 <= disc2:
+                disc_px[nd] = grey[y, x]
+                nd += 1
+    ring, ring_sd = _mean_and_sd(ring_px[:nr])
+    disc, disc_sd = _mean_and_sd(disc_px[:nd])
+    return ring, disc, ring_sd, disc_sd
 
 
-def _mean(values: np.ndarray) -> float:
-    """values.astype(float).mean() of uint8 values, exactly: their sum is an integer."""
-    return int(values.sum(dtype=np.int64)) / values.size
+@njit(cache=True)
+def _mean_and_sd(values: np.ndarray) -> tuple[float, float]:
+    # (values' mean, its standard deviation) as numpy's mean and std of them in float64
+    n = values.size
+    if n == 0:
+        return 0.0, 255.0
+    mean = values.sum() / n  # an exact integer sum, then one rounding, as numpy's
+    sq = np.empty(n)
+    for i in range(n):
+        e = np.float64(values[i]) - mean
+        sq[i] = e * e
+    return mean, math.sqrt(_numpy_sum(sq) / n)
 
 
 def find_aruco(image: np.ndarray) -> list[Blob]:

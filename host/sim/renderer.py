@@ -27,6 +27,7 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
+from numba import njit
 
 from host.camera.source import StereoFrame
 from host.sim.faults import CameraFaults
@@ -86,17 +87,34 @@ def _coverage(qx: np.ndarray, qy: np.ndarray, ts: tuple[float, ...]) -> list[np.
     rows x 4). A sum rounded to float64 never decreases as a term grows, so a pixel whose
     largest terms pass is covered and one whose least fail is not; only the pixels between
     count their samples."""
-    hi = qy.max(1)[:, None] + qx.max(1)[None, :]
-    lo = qy.min(1)[:, None] + qx.min(1)[None, :]
-    covs = [(hi <= t).astype(np.float64) for t in ts]
-    edge = np.zeros(hi.shape, bool)
-    for t in ts:
-        edge |= (hi > t) & (lo <= t)
-    r, c = np.nonzero(edge)
-    samples = qx[c][:, None, :] + qy[r][:, :, None]
-    for t, cov in zip(ts, covs):
-        cov[r, c] = np.count_nonzero(samples <= t, axis=(1, 2)) / 16
-    return covs
+    covs = _coverage_of(np.ascontiguousarray(qx, np.float64),
+                        np.ascontiguousarray(qy, np.float64), np.asarray(ts, np.float64))
+    return list(covs)
+
+
+@njit(cache=True)
+def _coverage_of(qx: np.ndarray, qy: np.ndarray, ts: np.ndarray) -> np.ndarray:
+    """_coverage's fractions (ts, rows, columns) in one pass: the same sums and comparisons."""
+    rows, cols = qy.shape[0], qx.shape[0]
+    out = np.empty((ts.size, rows, cols))
+    for i in range(rows):
+        y_lo, y_hi = qy[i].min(), qy[i].max()
+        for j in range(cols):
+            hi = y_hi + qx[j].max()
+            lo = y_lo + qx[j].min()
+            for k in range(ts.size):
+                t = ts[k]
+                if hi <= t:
+                    out[k, i, j] = 1.0
+                elif lo > t:
+                    out[k, i, j] = 0.0
+                else:
+                    n = 0
+                    for a in range(qy.shape[1]):
+                        for b in range(qx.shape[1]):
+                            n += qx[j, b] + qy[i, a] <= t
+                    out[k, i, j] = n / 16
+    return out
 
 
 LensBounds = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
@@ -115,20 +133,37 @@ def _lens_hit_box(bounds: LensBounds, mx: np.ndarray, my: np.ndarray,
     strictly inside limits (lo_x, hi_x, lo_y, hi_y), None if none does. Such a pixel is in a
     row whose source rows reach into (lo_y, hi_y) and a column whose source columns reach
     into (lo_x, hi_x): the pixels are looked for in those rows and columns alone."""
-    lo_x, hi_x, lo_y, hi_y = limits
-    row_lo, row_hi, col_lo, col_hi = bounds
-    rows = np.flatnonzero((row_hi > lo_y) & (row_lo < hi_y))
-    cols = np.flatnonzero((col_hi > lo_x) & (col_lo < hi_x))
-    if not rows.size or not cols.size:
-        return None
-    ra, rb, ca, cb = int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1
-    sx, sy = mx[ra:rb, ca:cb], my[ra:rb, ca:cb]
-    hit = (sx > lo_x) & (sx < hi_x) & (sy > lo_y) & (sy < hi_y)
-    hit_rows, hit_cols = np.flatnonzero(hit.any(1)), np.flatnonzero(hit.any(0))
-    if not hit_rows.size:
-        return None
-    return (ra + int(hit_rows[0]), ra + int(hit_rows[-1]) + 1,
-            ca + int(hit_cols[0]), ca + int(hit_cols[-1]) + 1)
+    # the limits as float32, as numpy compares a float32 array with a Python float
+    got = _lens_hit_of(*bounds, mx, my, *(np.float32(v) for v in limits))
+    return None if got[0] < 0 else got
+
+
+@njit(cache=True)
+def _lens_hit_of(row_lo: np.ndarray, row_hi: np.ndarray, col_lo: np.ndarray,
+                 col_hi: np.ndarray, mx: np.ndarray, my: np.ndarray, lo_x: np.float32,
+                 hi_x: np.float32, lo_y: np.float32, hi_y: np.float32
+                 ) -> tuple[int, int, int, int]:
+    """_lens_hit_box's box in one pass over the candidate rows and columns; y0 = -1: none."""
+    ra, rb, ca, cb = -1, -1, -1, -1
+    for y in range(row_lo.size):
+        if row_hi[y] > lo_y and row_lo[y] < hi_y:
+            ra = y if ra < 0 else ra
+            rb = y + 1
+    for x in range(col_lo.size):
+        if col_hi[x] > lo_x and col_lo[x] < hi_x:
+            ca = x if ca < 0 else ca
+            cb = x + 1
+    y0, y1, x0, x1 = -1, -1, col_lo.size, -1
+    if ra < 0 or ca < 0:
+        return y0, y1, x0, x1
+    for y in range(ra, rb):
+        for x in range(ca, cb):
+            sx, sy = mx[y, x], my[y, x]
+            if sx > lo_x and sx < hi_x and sy > lo_y and sy < hi_y:
+                y0 = y if y0 < 0 else y0
+                y1 = y + 1
+                x0, x1 = min(x0, x), max(x1, x + 1)
+    return y0, y1, x0, x1
 
 
 class Renderer:

@@ -138,22 +138,31 @@ class World:
     def step(self, dt: float, duty_left: float, duty_right: float) -> None:
         """Move the robot for dt seconds under the duties its wheels get (permille), through
         the motor faults: gain and offset per wheel, battery sag with distance, wheel slip,
-        and the floor's traction."""
+        and the floor's traction. (Called every simulated millisecond: one wheel at a time,
+        without building lists, the same operations in the same order.)"""
         r, m, f = self.robot, self.motors, self.motor_faults
         self.t += dt
         a = 1.0 - math.exp(-dt / m.tau_s)
         supply = max(0.5, 1.0 - f.sag_per_m * self.travelled_m)
-        targets = []
-        for duty, gain, offset, grip in ((duty_left, f.gain[0], f.offset[0], self.traction[0]),
-                                         (duty_right, f.gain[1], f.offset[1], self.traction[1])):
-            v = m.speed(duty * supply - math.copysign(offset, duty) if duty else 0.0) * gain * grip
-            if f.slip and v:
-                v *= 1.0 - f.slip * float(self.rng.random())
-            targets.append(v)
-        r.v_left += (targets[0] - r.v_left) * a
-        r.v_right += (targets[1] - r.v_right) * a
+        # a wheel without duty: speed(0.0) is 0 and nothing slips (the robot holding)
+        t_left = (self._wheel(duty_left, supply, f.gain[0], f.offset[0], self.traction[0])
+                  if duty_left else 0.0 * f.gain[0] * self.traction[0])
+        t_right = (self._wheel(duty_right, supply, f.gain[1], f.offset[1], self.traction[1])
+                   if duty_right else 0.0 * f.gain[1] * self.traction[1])
+        r.v_left += (t_left - r.v_left) * a
+        r.v_right += (t_right - r.v_right) * a
         v = (r.v_left + r.v_right) / 2
         r.theta += (r.v_left - r.v_right) / m.wheelbase_m * dt
         r.x_m += (v * math.sin(r.theta) + f.push_mps) * dt
         r.z_m += v * math.cos(r.theta) * dt
         self.travelled_m += abs(v) * dt
+
+    def _wheel(self, duty: float, supply: float, gain: float, offset: float,
+               grip: float) -> float:
+        """A wheel's target speed (m/s) under its duty, with its faults (slip drawn here)."""
+        v = self.motors.speed(duty * supply - math.copysign(offset, duty) if duty else 0.0) \
+            * gain * grip
+        slip = self.motor_faults.slip
+        if slip and v:
+            v *= 1.0 - slip * float(self.rng.random())
+        return v

@@ -156,13 +156,23 @@ def _slide(win, enter, leave):
 
 
 @njit(cache=True, fastmath=True, inline="always")
-def _interior(col, win, floor, idx, out, yi, x_from, x_to, half, dmin, nd, fit):
+def _keep_costs(skew, win, x, kmin, nd):
+    # output x's costs of candidates kmin .. nd - 1 where the right map reads them (skew)
+    for k in range(kmin, nd):
+        skew[x + k, k] = win[k]
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _interior(col, win, floor, idx, skew, out, yi, x_from, x_to, half, dmin, nd, fit,
+              want_right):
     """The common case: both window columns inside, every candidate allowed, no uniqueness.
 
     Reads the column sums by index (no views) and fuses the slide with the minimum.
     """
     for x in range(x_from, x_to):
         best, m = _slide_lowest(win, floor, idx, col, x + half, x - half - 1)
+        if want_right:
+            _keep_costs(skew, win, x, 0, nd)
         off = 0.0
         if fit != FIT_NONE and 0 < best < nd - 1:
             off = fit_offset(np.float32(win[best - 1]), np.float32(m),
@@ -171,7 +181,8 @@ def _interior(col, win, floor, idx, out, yi, x_from, x_to, half, dmin, nd, fit):
 
 
 @njit(cache=True, fastmath=True, inline="always")
-def _edge(col, win, floor, idx, efloor, eidx, out, yi, x_from, x_to, half, dmin, nd, fit):
+def _edge(col, win, floor, idx, efloor, eidx, skew, out, yi, x_from, x_to, half, dmin, nd, fit,
+          want_right):
     """Outputs whose right windows leave the image for some candidates (kmin > 0): both window
     columns inside, no uniqueness. As _interior, with the candidates below kmin lifted out by
     efloor / eidx (a copy of floor / idx whose lanes below kmin say top / none; kmin falls by
@@ -186,6 +197,8 @@ def _edge(col, win, floor, idx, efloor, eidx, out, yi, x_from, x_to, half, dmin,
         efloor[kmin] = floor[kmin]
         eidx[kmin] = idx[kmin]
         best, m = _slide_lowest(win, efloor, eidx, col, x + half, x - half - 1)
+        if want_right:
+            _keep_costs(skew, win, x, kmin, nd)
         off = 0.0
         if fit != FIT_NONE and kmin < best < nd - 1:
             off = fit_offset(np.float32(win[best - 1]), np.float32(m),
@@ -194,9 +207,10 @@ def _edge(col, win, floor, idx, efloor, eidx, out, yi, x_from, x_to, half, dmin,
 
 
 @njit(cache=True, fastmath=True)
-def _row_outputs(col, win, zero, floor, idx, efloor, eidx, rowcost, out, yi, x_from, x_to,
-                 x_start, half, w, dmin, nd, top, uniqueness, fit, want_right):
-    """Slide the window over outputs x in [x_from, x_to) of one row, writing out[yi, x]."""
+def _row_outputs(col, win, zero, floor, idx, efloor, eidx, skew, out, yi, x_from, x_to,
+                 x_start, half, w, dmin, nd, uniqueness, fit, want_right):
+    """Slide the window over outputs x in [x_from, x_to) of one row, writing out[yi, x] (and,
+    want_right, each output's costs into skew for _right_row)."""
     if x_from == x_start:
         win[:] = 0
         for xx in range(max(0, x_start - half), x_start + half):
@@ -207,19 +221,20 @@ def _row_outputs(col, win, zero, floor, idx, efloor, eidx, rowcost, out, yi, x_f
     # outputs left of those with some candidates' right windows outside (kmin > 0)
     edge_lo = max(x_from, half + 1, half + dmin)
     edge_hi = min(x_to, w - half, half + dmin + nd - 1)
-    if uniqueness > 0.0 or want_right or fast_hi <= fast_lo:
+    if uniqueness > 0.0 or fast_hi <= fast_lo:
         fast_lo = fast_hi = x_to
-    if uniqueness > 0.0 or want_right or edge_hi <= edge_lo:
+    if uniqueness > 0.0 or edge_hi <= edge_lo:
         edge_lo = edge_hi = x_to
     x = x_from
     while x < x_to:
         if x == edge_lo:
-            _edge(col, win, floor, idx, efloor, eidx, out, yi, edge_lo, edge_hi, half, dmin,
-                  nd, fit)
+            _edge(col, win, floor, idx, efloor, eidx, skew, out, yi, edge_lo, edge_hi, half,
+                  dmin, nd, fit, want_right)
             x = edge_hi
             continue
         if x == fast_lo:
-            _interior(col, win, floor, idx, out, yi, fast_lo, fast_hi, half, dmin, nd, fit)
+            _interior(col, win, floor, idx, skew, out, yi, fast_lo, fast_hi, half, dmin, nd,
+                      fit, want_right)
             x = fast_hi
             continue
         enter = col[x + half] if x + half < w else zero
@@ -233,31 +248,31 @@ def _row_outputs(col, win, zero, floor, idx, efloor, eidx, rowcost, out, yi, x_f
             k, _ = _lowest(win, floor, idx)
         else:
             if dmax < 0:
-                if want_right:
-                    rowcost[x - 1, :] = top
                 continue
             k = _argmin(win, kmin, nd)
         if want_right:
-            rowcost[x - 1, :] = win[:nd]
-            rowcost[x - 1, :kmin] = top
+            _keep_costs(skew, win, x - 1, kmin, nd)
         off, ok = _decide(win, k, kmin, nd, uniqueness, fit)
         if ok:
             out[yi, x - 1] = dmin + nd - 1 - k - off
 
 
 @njit(cache=True, fastmath=True)
-def _right_row(rowcost, disp_r, y, w, x_start, x_end, dmin, nd, top, fit):
-    # the cost of right pixel xr at disparity d is the left cost at x = xr + d
-    c = np.empty(nd, dtype=rowcost.dtype)
+def _right_row(skew, disp_r, y, w, dmin, nd, top, fit):
+    """The right map's row y. The cost of right pixel xr at candidate k is the left cost of
+    x = xr + dmin + nd - 1 - k, which _keep_costs put at skew[x + k, k]: right pixel xr's
+    costs are the one row skew[xr + dmin + nd - 1] (top where that x has no cost: outside the
+    outputs' columns, or its right window outside the image)."""
     for xr in range(w):
-        any_valid = False
+        c = skew[xr + dmin + nd - 1]
+        m = top
         for k in range(nd):
-            x = xr + dmin + nd - 1 - k
-            c[k] = rowcost[x, k] if x_start <= x < x_end else top
-            any_valid = any_valid or c[k] != top
-        if not any_valid:
+            m = min(m, c[k])
+        if m == top:
             continue
-        k = _argmin(c, 0, nd)
+        k = 0
+        while c[k] != m:
+            k += 1
         off, _ = _decide(c, k, 0, nd, 0.0, fit)
         disp_r[y, xr] = dmin + nd - 1 - k - off
 
@@ -304,14 +319,16 @@ def match_sad(left, right, dmin, nd, half, uniqueness, fit, want_right, clip, co
         idx = np.minimum(np.arange(ndp + 1), nd).astype(wdt)
         efloor = floor.copy()
         eidx = idx.copy()
-        rowcost = np.full((w if want_right else 1, nd), top, dtype=wdt)
+        # the costs the right map reads, skewed (_keep_costs); written at the same places in
+        # every row, and never where a candidate has no cost, so top there stays
+        skew = np.full((w + dmin + nd - 1 if want_right else 1, nd), top, dtype=wdt)
         for yy in range(y0 - half, y0 + half + 1):
             _cols_add(col, left_p, right_p, yy, 0, w, base0, ndc)
         for y in range(y0, y1):
             yi = y - ro  # image row
             if y == y0:
-                _row_outputs(col, win, zero, floor, idx, efloor, eidx, rowcost, disp_l, yi,
-                             x_start, x_end, x_start, half, w, dmin, nd, top, uniqueness, fit,
+                _row_outputs(col, win, zero, floor, idx, efloor, eidx, skew, disp_l, yi,
+                             x_start, x_end, x_start, half, w, dmin, nd, uniqueness, fit,
                              want_right)
             else:
                 done = x_start
@@ -321,10 +338,10 @@ def match_sad(left, right, dmin, nd, half, uniqueness, fit, want_right, clip, co
                                 ndc)
                     upto = x_end if tx1 == w else min(x_end, tx1 - half)
                     if upto > done:
-                        _row_outputs(col, win, zero, floor, idx, efloor, eidx, rowcost,
-                                     disp_l, yi, done, upto, x_start, half, w, dmin, nd, top,
+                        _row_outputs(col, win, zero, floor, idx, efloor, eidx, skew,
+                                     disp_l, yi, done, upto, x_start, half, w, dmin, nd,
                                      uniqueness, fit, want_right)
                         done = upto
             if want_right:
-                _right_row(rowcost, disp_r, yi, w, x_start, x_end, dmin, nd, top, fit)
+                _right_row(skew, disp_r, yi, w, dmin, nd, top, fit)
     return disp_l, disp_r

@@ -78,4 +78,4 @@ def test_percentile_from_histogram() -> None:
         shape = tuple(int(v) for v in rng.integers(1, 30, 2))
         lo, hi = sorted(int(v) for v in rng.integers(0, 256, 2))
         patch = rng.integers(lo, hi + 1, shape).astype(np.uint8)
-        assert marker._p90(patch) == np.percentile(patch.astype(np.float64), 90)
+        assert marker._p90_of(patch) == np.percentile(patch.astype(np.float64), 90)
