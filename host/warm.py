@@ -2,8 +2,9 @@
 
 `python -m host.warm` (the Makefile's venv step runs it) calls each own matcher on a small
 random pair with every lane width, channel count and option that selects a different compiled
-signature, and the self-supervised tuner's census and terms (host tune --objective self), so
-the first `host eval` or `host tune` loads machine code instead of compiling it. The jobs are
+signature, the self-supervised tuner's census and terms (host tune --objective self), and the
+simulated servo's renderer and marker search, so the first `host eval`, `host tune` or `host
+servo --sim` loads machine code instead of compiling it. The jobs are
 shared among `--processes` processes (default: one per core, at most 2): compiling is
 single-threaded, and the two 4-path SGM signatures alone take most of the time. It sits above
 host.stereo and host.tuning, whose kernels it compiles.
@@ -57,6 +58,22 @@ def _tuner(rng: np.random.Generator) -> None:
     terms_of_maps(left, np.roll(left, -3, axis=1), disp)
 
 
+def _servo_sim() -> None:
+    """The simulated servo's own kernels: a lensed view of the default world drawn (marker
+    coverage, the lens's redraw boxes) in grey and in colour, and the marker searched in it
+    (specks, centroid, ring and disc), so the first `host servo --sim` does not compile them."""
+    from host.servo.marker import find_discs
+    from host.sim.faults import CameraFaults
+    from host.sim.renderer import Renderer
+    from host.sim.world import World
+
+    world = World.for_size(320, 240, seed=0)
+    for grey in (True, False):
+        frame = Renderer(world, CameraFaults(distortion=(-0.05, -0.05)), seed=0,
+                         grey=grey).frame()
+        find_discs(frame.left)
+
+
 def warm(part: int = 0, parts: int = 1) -> int:
     """Run every parts-th matcher variant from part on once on a small random colour pair, and
     in the last part the tuner's kernels; returns how many jobs ran."""
@@ -69,7 +86,9 @@ def warm(part: int = 0, parts: int = 1) -> int:
         compute_disparity(left, right, p.replace(num_disparities=16))
     if part == parts - 1:
         _tuner(rng)
-    return len(ps) + (part == parts - 1)
+    if part == 0:
+        _servo_sim()
+    return len(ps) + (part == parts - 1) + (part == 0)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -94,9 +113,9 @@ def main(argv: list[str] | None = None) -> int:
         if any(p.wait() for p in parts):
             print("a warm-up process failed (above)", file=sys.stderr)
             return 1
-        n = len(variants()) + 1
+        n = len(variants()) + 2
     print(f"numba kernels compiled or loaded from cache: {n} jobs (matcher variants, the "
-          f"self-supervised tuner) in "
+          f"self-supervised tuner, the servo simulation) in "
           f"{args.processes} processes, {time.perf_counter() - t0:.1f} s", file=sys.stderr)
     return 0
 

@@ -131,7 +131,7 @@ def _block_sum(a: np.ndarray, lo: int, n: int) -> float:
     while i < n:
         res += a[lo + i]
         i += 1
-    return res
+    return float(res)  # a float64 already: float() only tells mypy
 
 
 @njit(cache=True)

@@ -88,7 +88,8 @@ def _hit(bounds: tuple[np.ndarray, ...], m1: np.ndarray, box: tuple[int, int, in
     none does: the source x in c0 - 1 .. c1 - 1 and y in r0 - 1 .. r1 - 1, looked for in the
     rows and columns whose bounds reach there."""
     r0, r1, c0, c1 = box
-    got = _hit_of(*bounds, m1, r0 - 1, r1 - 1, c0 - 1, c1 - 1)
+    row_lo, row_hi, col_lo, col_hi = bounds
+    got = _hit_of(row_lo, row_hi, col_lo, col_hi, m1, r0 - 1, r1 - 1, c0 - 1, c1 - 1)
     return None if got[0] < 0 else got
 
 
