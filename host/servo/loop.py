@@ -97,7 +97,7 @@ from host.servo.rereference import (
 from host.servo.rig import reference_image, vertical_shift_px
 from host.servo.snapshot import Observer, Snapshot, link_stats
 from host.servo.timing import FrameTiming, TimingConfig
-from host.servo.tracker import TargetTracker, TrackerConfig
+from host.servo.tracker import TargetTracker, TrackerConfig, with_target
 from host.stereo.matcher import compute_disparity
 from host.stereo.params import MatcherParams
 
@@ -523,6 +523,8 @@ class Servo:
             frame.left, frame.right, t.bbox, t.disparity))
         if self.tracker.measured:
             self._measured_t = frame.t_left
+            if not self.tracker.retargeted:
+                self._lane_follows(clean, target)
         if self.tracker.stop_reason:
             if self._back_to_target(clean, frame):  # a nearer object that came and went
                 return
@@ -534,6 +536,16 @@ class Servo:
             self.controller.keep_out = self._extent(object_extent(clean, target))
         self.controller.target_m = self.geometry.depth_m(aligned_disparity(
             frame.left, frame.right, clean, target.bbox, target.disparity, hide=hide))
+
+    def _lane_follows(self, clean: np.ndarray, target: Target) -> None:
+        """The lane's reference with the target where the re-measure found it (tracker's
+        with_target): a target that moved is not a new object in the lane."""
+        assert self.reference_map is not None and self.controller is not None
+        if self.controller.keep_out is None:
+            return
+        self._lane_reference = self._lane_map(with_target(
+            self.reference_map, object_extent(clean, target), self.controller.keep_out,
+            self.geometry.baseline_m, self.geometry.cx, self.params.block_size // 2 + 1))
 
     @property
     def tracker_confirmed(self) -> bool:
