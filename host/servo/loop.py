@@ -1031,6 +1031,8 @@ class Servo:
         c.fixed = old.fixed
         self.controller = c
         self._cmd = Command(0, 0, Phase.WAIT, None)
+        # the drives, turns and losses before it belong to a heading the probe sets afresh
+        self.lost_card, self.refind = LostCard(self.cfg.refind), None
         self.notes.append(f"recovered ({why}): re-acquiring the robot")
 
     def _rereference_frame(self, frame: StereoFrame, pair: MarkerPair | None) -> bool:
