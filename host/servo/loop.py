@@ -105,6 +105,8 @@ AGAINST_REASON = "the depth moves against the commanded direction"
 STILL_REASON = "the marker did not move while the robot drove"
 MAX_FLIPS = 2  # heading corrections in a run before "against" ends it
 REREFERENCE_TRIES = 3  # re-references (of reference_frames each) before a moved camera stops
+LATE_S = 0.5  # a wait still on this near the run's deadline ends the run, named (a few frames
+# before the run driver's own check)
 
 
 def marker_band(params: MatcherParams, d: float) -> MatcherParams:
@@ -275,6 +277,8 @@ class Servo:
         self.progress = Progress(self.cfg.progress)  # no progress for long: the run ends
         self.refind: Refind | None = None  # the card lost while driving, looked for (refind.py)
         self.lost_card = LostCard(self.cfg.refind)  # the refind's bookkeeping (refind.py)
+        self.deadline: float | None = None  # on clock(): the run driver ends the run then
+        # (servo_run.Rules.limit_s); a wait still on just before it ends it, named (_too_late)
 
     @property
     def strips(self) -> StripMap | None:
@@ -869,6 +873,7 @@ class Servo:
             cmd, invalid = self._watch_lane(frame, t, cmd, invalid)
         stalled = self.progress.update(t, cmd.phase, cmd.error_m, self.target_m,
                                        waiting=bool(waiting) or self.recovery.active)
+        stalled = stalled or self._too_late()
         if stalled and not self.stop_reason:  # STOP now: the run ends with this step
             self.stop_reason = stalled
             self.notes.append(f"{stalled}: {self.progress.detail()}")
@@ -962,6 +967,16 @@ class Servo:
                             keep_estimate=True)
             return Command(0, 0, Phase.FIND, None)
         return Command(left, right, Phase.SEARCH, None)
+
+    def _too_late(self) -> str:
+        """A wait (recovery.py) still on LATE_S before the run's deadline: the run ends as the
+        stop the wait would have ended in, named, rather than at the deadline neither held nor
+        stopped (a wait's bound, up to 20 s, may reach past it: seed 12's trial 482 waited on
+        the lane from 28.5 s); "" otherwise."""
+        rec = self.recovery
+        if self.deadline is None or not rec.active or self.clock() < self.deadline - LATE_S:
+            return ""
+        return f"{rec.reason}: still waiting ({rec.kind}) when the run's time ran out"
 
     def _must_stop(self) -> bool:
         return bool(self.stop_reason)
