@@ -527,8 +527,9 @@ class Servo:
             frame.left, frame.right, t.bbox, t.disparity))
         if self.tracker.measured:
             self._measured_t = frame.t_left
-            if not self.tracker.retargeted:
-                self._lane_follows(clean, target)
+            if not (self.tracker.retargeted or self._targets_before):
+                self._lane_follows(clean, target)  # the reference's object only: a box
+                # that replaced it is new in the lane, and its wait may see it taken away
         if self.tracker.stop_reason:
             if self._back_to_target(clean, frame):  # a nearer object that came and went
                 return
