@@ -97,7 +97,7 @@ from host.servo.rereference import (
 from host.servo.rig import reference_image, vertical_shift_px
 from host.servo.snapshot import Observer, Snapshot, link_stats
 from host.servo.timing import FrameTiming, TimingConfig
-from host.servo.tracker import TargetTracker, TrackerConfig
+from host.servo.tracker import TargetTracker, TrackerConfig, with_target
 from host.stereo.matcher import compute_disparity
 from host.stereo.params import MatcherParams
 
@@ -105,6 +105,8 @@ AGAINST_REASON = "the depth moves against the commanded direction"
 STILL_REASON = "the marker did not move while the robot drove"
 MAX_FLIPS = 2  # heading corrections in a run before "against" ends it
 REREFERENCE_TRIES = 3  # re-references (of reference_frames each) before a moved camera stops
+LATE_S = 0.5  # a wait still on this near the run's deadline ends the run, named (a few frames
+# before the run driver's own check)
 
 
 def marker_band(params: MatcherParams, d: float) -> MatcherParams:
@@ -275,6 +277,8 @@ class Servo:
         self.progress = Progress(self.cfg.progress)  # no progress for long: the run ends
         self.refind: Refind | None = None  # the card lost while driving, looked for (refind.py)
         self.lost_card = LostCard(self.cfg.refind)  # the refind's bookkeeping (refind.py)
+        self.deadline: float | None = None  # on clock(): the run driver ends the run then
+        # (servo_run.Rules.limit_s); a wait still on just before it ends it, named (_too_late)
 
     @property
     def strips(self) -> StripMap | None:
@@ -523,6 +527,9 @@ class Servo:
             frame.left, frame.right, t.bbox, t.disparity))
         if self.tracker.measured:
             self._measured_t = frame.t_left
+            if not (self.tracker.retargeted or self._targets_before):
+                self._lane_follows(clean, target)  # the reference's object only: a box
+                # that replaced it is new in the lane, and its wait may see it taken away
         if self.tracker.stop_reason:
             if self._back_to_target(clean, frame):  # a nearer object that came and went
                 return
@@ -534,6 +541,16 @@ class Servo:
             self.controller.keep_out = self._extent(object_extent(clean, target))
         self.controller.target_m = self.geometry.depth_m(aligned_disparity(
             frame.left, frame.right, clean, target.bbox, target.disparity, hide=hide))
+
+    def _lane_follows(self, clean: np.ndarray, target: Target) -> None:
+        """The lane's reference with the target where the re-measure found it (tracker's
+        with_target): a target that moved is not a new object in the lane."""
+        assert self.reference_map is not None and self.controller is not None
+        if self.controller.keep_out is None:
+            return
+        self._lane_reference = self._lane_map(with_target(
+            self.reference_map, object_extent(clean, target), self.controller.keep_out,
+            self.geometry.baseline_m, self.geometry.cx, self.params.block_size // 2 + 1))
 
     @property
     def tracker_confirmed(self) -> bool:
@@ -857,6 +874,7 @@ class Servo:
             cmd, invalid = self._watch_lane(frame, t, cmd, invalid)
         stalled = self.progress.update(t, cmd.phase, cmd.error_m, self.target_m,
                                        waiting=bool(waiting) or self.recovery.active)
+        stalled = stalled or self._too_late()
         if stalled and not self.stop_reason:  # STOP now: the run ends with this step
             self.stop_reason = stalled
             self.notes.append(f"{stalled}: {self.progress.detail()}")
@@ -951,6 +969,16 @@ class Servo:
             return Command(0, 0, Phase.FIND, None)
         return Command(left, right, Phase.SEARCH, None)
 
+    def _too_late(self) -> str:
+        """A wait (recovery.py) still on LATE_S before the run's deadline: the run ends as the
+        stop the wait would have ended in, named, rather than at the deadline neither held nor
+        stopped (a wait's bound, up to 20 s, may reach past it: seed 12's trial 482 waited on
+        the lane from 28.5 s); "" otherwise."""
+        rec = self.recovery
+        if self.deadline is None or not rec.active or self.clock() < self.deadline - LATE_S:
+            return ""
+        return f"{rec.reason}: still waiting ({rec.kind}) when the run's time ran out"
+
     def _must_stop(self) -> bool:
         return bool(self.stop_reason)
 
@@ -1019,6 +1047,8 @@ class Servo:
         c.fixed = old.fixed
         self.controller = c
         self._cmd = Command(0, 0, Phase.WAIT, None)
+        # the drives, turns and losses before it belong to a heading the probe sets afresh
+        self.lost_card, self.refind = LostCard(self.cfg.refind), None
         self.notes.append(f"recovered ({why}): re-acquiring the robot")
 
     def _rereference_frame(self, frame: StereoFrame, pair: MarkerPair | None) -> bool:

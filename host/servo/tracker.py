@@ -201,3 +201,25 @@ class TargetTracker:
         self.retargeted = self.measured = True
         self.fresh = None
         return vouched
+
+
+def with_target(reference: np.ndarray, target: Target, extent_m: tuple[float, float],
+                baseline_m: float, cx: float, margin_px: float = 5.0) -> np.ndarray:
+    """The reference map (px) with the target where it stands now: the lane's reference
+    after the target moved. A box pushed farther shows its edge in columns where the reference
+    saw the wall behind it, and the lane (perception.lane_obstacle: nearer than the reference
+    is new) took its own corner for a new object in the lane (seed 12's trial 482). The
+    target's face, at its disparity now, across its rows (target: object_extent's region) and
+    the columns within extent_m (the object's lateral extent, m, as the reference measured it;
+    margin_px more either side at the target's disparity: the matcher's fattening at an edge),
+    raises the reference to that disparity: there the target's face is no new object, seen or
+    hidden by the robot when the target was measured. What stands nearer than the face, or
+    beside it, stays new. Returns a new map."""
+    d = target.disparity
+    _, y, _, bh = target.bbox
+    out = reference.copy()
+    lateral = baseline_m * (np.arange(reference.shape[1]) - cx) / d
+    margin = margin_px * baseline_m / d
+    cols = (lateral >= extent_m[0] - margin) & (lateral <= extent_m[1] + margin)
+    out[y:y + bh, cols] = np.fmax(out[y:y + bh, cols], d)
+    return out

@@ -228,3 +228,29 @@ def test_a_card_seen_only_in_glimpses_is_looked_for_as_lost() -> None:
             sent.append(_frame(servo, t, None))
     assert any(c.phase == Phase.SEARCH for c in sent), [str(c.phase) for c in sent]
     assert servo.recovery.kind == "lost" or any("found again" in n for n in servo.notes)
+
+
+def test_drives_before_a_re_acquisition_do_not_turn_the_robot_round_after_it() -> None:
+    """The depth moved away from the target over drives (2.5 to 2.65 m), then the robot was
+    re-acquired (a reset, a moved camera, a whole-view search), its probe setting the heading
+    afresh. A loss after three drives on the new heading judges those alone: the drives before
+    the probe (LostCard's bookkeeping kept through it) turned the robot round against what the
+    probe had just shown."""
+    servo = _servo()
+    assert servo.controller is not None
+    rng = np.random.default_rng(3)
+    t = 0.0
+    for i in range(30):
+        t += 0.033
+        _frame(servo, t, 2.5 + 0.005 * i + float(rng.normal(0, 0.02)), lateral=0.002 * i,
+               aspect=1.0)
+    servo._reacquire(probe=True, why="the robot's board reset")
+    servo.acquisition.phase = Phase.DONE  # its probe showed the heading kept
+    for _ in range(3):
+        t += 0.033
+        _frame(servo, t, 2.65 + float(rng.normal(0, 0.02)), lateral=0.06, aspect=1.0)
+    while t < 3.0:
+        t += 0.033
+        _frame(servo, t, None)
+    assert servo.controller.facing_away is False
+    assert not any("faces the other way" in n for n in servo.notes), servo.notes
