@@ -47,6 +47,8 @@ def run_servo(servo: Servo, rules: Rules, clock: Callable[[], float],
     each(row): called after every step (notes, a status line). Errors of the link or the camera
     leave as exceptions; the caller's link context sends STOP."""
     t0 = clock()
+    if rules.limit_s is not None:  # a wait still on near it ends the run named (Servo._too_late)
+        servo.deadline = t0 + rules.limit_s
     lost_since: float | None = None
     while True:
         try:

@@ -800,6 +800,8 @@ class Servo:
         if acq.done:
             assert self.controller is not None and acq.facing_away is not None
             self.controller.facing_away = acq.facing_away
+            if acq.probes:  # its move showed the facing beyond the depth noise (acquire.py)
+                self.heading.way = 1 if acq.facing_away else -1
             if not acq.facing_away and acq.probes:
                 self.notes.append("the probe move showed that the robot faces the camera")
         return Command(order.left, order.right, order.phase, None)
@@ -845,6 +847,8 @@ class Servo:
         frozen = self.frozen.update(frame)
         frame = self._exposed(frame)
         t = frame.t_left
+        # the command in force up to this frame (a stop's run-down spent before any check)
+        self.estimator.commanded(t, self._cmd.left, self._cmd.right)
         invalid = self.timing.check(self.clock(), t, frame.t_right) or frozen
         seen = self._see(frame)
         pair = seen.pair
