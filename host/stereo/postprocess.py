@@ -61,9 +61,29 @@ def fill_background(disp: np.ndarray) -> np.ndarray:
 
 
 def median(disp: np.ndarray, size: int) -> np.ndarray:
-    """Median filter (size 3 or 5) that keeps NaN where the input had no disparity."""
-    invalid = np.isnan(disp)
-    filled = np.where(invalid, 0.0, disp).astype(np.float32)
-    out = cv2.medianBlur(filled, size)
-    out[invalid] = np.nan
+    """Median filter (size 3 or 5) that keeps NaN where the input had no disparity (which
+    counts as 0 in its neighbours' medians). A map of whole pixels in 0 .. 65535 (SGM's
+    defaults) is filtered as uint16: the same order statistics, a fifth of float32's time."""
+    whole = np.empty(disp.shape, dtype=np.uint16)
+    if _as_whole(np.ascontiguousarray(disp), whole):
+        out = cv2.medianBlur(whole, size).astype(np.float32)
+    else:
+        out = cv2.medianBlur(np.where(np.isnan(disp), 0.0, disp).astype(np.float32), size)
+    out[np.isnan(disp)] = np.nan
     return out
+
+
+@njit(cache=True)
+def _as_whole(disp: np.ndarray, out: np.ndarray) -> bool:
+    """disp into out (uint16, NaN as 0) if every valid value is a whole number in 0 .. 65535;
+    False at the first that is not (out is then partly written)."""
+    flat, o = disp.ravel(), out.ravel()
+    for i in range(flat.size):
+        v = flat[i]
+        if np.isnan(v):
+            o[i] = 0
+        elif v >= 0.0 and v <= 65535.0 and v == np.floor(v):
+            o[i] = np.uint16(v)
+        else:
+            return False
+    return True

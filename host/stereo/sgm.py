@@ -144,7 +144,9 @@ def _cost_row(cl, crrev, gl, gr, vol, pl, prrev, term, y, dmin, crow, cs):
     loop over views vectorises; the same loop over 2-D indices does not). prrev holds the right
     image's planes the same way. The intensity term of a summed |difference| k over the
     channels is (min(k, term[1]) * term[2] + term[3]) >> term[4] (integer_term: the same as
-    cost.census_ad_volume's table at every k).
+    cost.census_ad_volume's table at every k), in uint16 lanes where kcap * a + b fits
+    (_term_row). The term and the Hamming distances run as two loops: joined, the uint64
+    popcount set the vector width of both (8 lanes), and the row took twice as long.
     """
     w, nd = crow.shape
     if vol.shape[0] > 0:
@@ -157,10 +159,8 @@ def _cost_row(cl, crrev, gl, gr, vol, pl, prrev, term, y, dmin, crow, cs):
         lrow, rrev = cl[y], crrev[y]
     far = np.uint16(term[0])
     ch = pl.shape[0]
-    kcap = np.int32(term[1])
-    ta = np.uint32(term[2])
-    tb = np.uint32(term[3])
-    ts = np.uint32(term[4])
+    kcap = np.uint16(min(term[1], 0xFFFF))
+    narrow = term[1] * term[2] + term[3] < 0x10000
     for x in range(w):
         a = lrow[x]
         base = w - 1 - x + dmin
@@ -169,27 +169,43 @@ def _cost_row(cl, crrev, gl, gr, vol, pl, prrev, term, y, dmin, crow, cs):
         if ch == 0:
             for j in range(nd):
                 c[j] = np.uint16(_popcount(a ^ r[j]))
-        elif ch == 1:
-            q0 = prrev[0, y, base:base + nd]
-            l0 = np.int32(pl[0, y, x])
-            for j in range(nd):
-                k = min(abs(l0 - np.int32(q0[j])), kcap)
-                c[j] = np.uint16(_popcount(a ^ r[j])) + np.uint16(
-                    (np.uint32(k) * ta + tb) >> ts)
         else:
-            q0 = prrev[0, y, base:base + nd]
-            q1 = prrev[1, y, base:base + nd]
-            q2 = prrev[2, y, base:base + nd]
-            l0 = np.int32(pl[0, y, x])
-            l1 = np.int32(pl[1, y, x])
-            l2 = np.int32(pl[2, y, x])
+            _term_row(pl, prrev, y, x, base, c, nd, kcap, term, narrow)
             for j in range(nd):
-                k = min(abs(l0 - np.int32(q0[j])) + abs(l1 - np.int32(q1[j]))
-                        + abs(l2 - np.int32(q2[j])), kcap)
-                c[j] = np.uint16(_popcount(a ^ r[j])) + np.uint16(
-                    (np.uint32(k) * ta + tb) >> ts)
+                c[j] = c[j] + np.uint16(_popcount(a ^ r[j]))
         for j in range(max(0, x - dmin + 1), nd):
             c[j] = far
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _term_row(pl, prrev, y, x, base, c, nd, kcap, term, narrow):
+    """The intensity term of left pixel x's candidates into c (see _cost_row): each channel's
+    |difference| as max - min of the uint8 levels, summed in uint16 (at most 3 x 255), capped,
+    then scaled in uint16 lanes (narrow) or uint32."""
+    ch = pl.shape[0]
+    q0 = prrev[0, y, base:base + nd]
+    l0 = pl[0, y, x]
+    if ch == 1:
+        for j in range(nd):
+            c[j] = min(np.uint16(max(l0, q0[j]) - min(l0, q0[j])), kcap)
+    else:
+        q1 = prrev[1, y, base:base + nd]
+        q2 = prrev[2, y, base:base + nd]
+        l1 = pl[1, y, x]
+        l2 = pl[2, y, x]
+        for j in range(nd):
+            k = np.uint16(np.uint16(max(l0, q0[j]) - min(l0, q0[j]))
+                          + np.uint16(max(l1, q1[j]) - min(l1, q1[j]))
+                          + np.uint16(max(l2, q2[j]) - min(l2, q2[j])))
+            c[j] = min(k, kcap)
+    if narrow:
+        ta, tb, ts = np.uint16(term[2]), np.uint16(term[3]), np.uint16(term[4])
+        for j in range(nd):
+            c[j] = np.uint16(np.uint16(c[j] * ta) + tb) >> ts
+    else:
+        wa, wb, ws = np.uint32(term[2]), np.uint32(term[3]), np.uint32(term[4])
+        for j in range(nd):
+            c[j] = np.uint16((np.uint32(c[j]) * wa + wb) >> ws)
 
 
 @njit(cache=True)
@@ -334,6 +350,22 @@ def _first_min(s, m, idx, n):
     return np.int64(best), np.float32(m)
 
 
+@njit(cache=True, fastmath=True, inline="always")
+def _close(s, c0, uniqueness, best, nd):
+    """Whether a candidate other than best and its two neighbours costs at most c0 * (1 +
+    uniqueness / 100) (the uniqueness test). The costs are whole numbers, so the bound is
+    floored and the costs counted in uint16 lanes (no float compare per candidate); best
+    itself always counts, so do its neighbours under the bound."""
+    bound = c0 * (1.0 + uniqueness / 100.0)
+    ib = np.uint16(min(np.floor(bound), 65535.0))
+    n = np.uint16(0)
+    for j in range(nd):
+        n = np.uint16(n + np.uint16(s[j] <= ib))
+    for j in range(max(best - 1, 0), min(best + 2, nd)):
+        n = np.uint16(n - np.uint16(s[j] <= ib))
+    return n > 0
+
+
 @njit(cache=True, fastmath=True)
 def _decide_row(tot, mins, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc, acc16,
                 sh, idx, jj, fb, rr, lr):
@@ -362,13 +394,8 @@ def _decide_row(tot, mins, y, dmin, uniqueness, fit, want_right, disp_l, disp_r,
         inner = 0 < best < nd - 1
         fb[1, x] = s[best - 1] if inner else c0  # no neighbours: a flat fit, offset 0
         fb[3, x] = s[best + 1] if inner else c0
-        if uniqueness > 0.0:
-            bound = c0 * (1.0 + uniqueness / 100.0)
-            close = 0
-            for j in range(nd):
-                close += (j < best - 1 or j > best + 1) and s[j] <= bound
-            if close:
-                fb[0, x] = np.nan
+        if uniqueness > 0.0 and _close(s, c0, uniqueness, best, nd):
+            fb[0, x] = np.nan
     _fit_row(fb, disp_l[y], dmin, fit, w)
     if not want_right:
         return
