@@ -144,9 +144,10 @@ def _cost_row(cl, crrev, gl, gr, vol, pl, prrev, term, y, dmin, crow, cs):
     loop over views vectorises; the same loop over 2-D indices does not). prrev holds the right
     image's planes the same way. The intensity term of a summed |difference| k over the
     channels is (min(k, term[1]) * term[2] + term[3]) >> term[4] (integer_term: the same as
-    cost.census_ad_volume's table at every k), in uint16 lanes where kcap * a + b fits
-    (_term_row). The term and the Hamming distances run as two loops: joined, the uint64
-    popcount set the vector width of both (8 lanes), and the row took twice as long.
+    cost.census_ad_volume's table at every k), in uint16 lanes for three channels where the
+    form is 16 bits at NARROW_SHIFT (_term_row3), else in uint32 (_term_row). The term and
+    the Hamming distances run as two loops: joined, the uint64 popcount set the vector width
+    of both (8 lanes), and the row took twice as long.
     """
     w, nd = crow.shape
     if vol.shape[0] > 0:
@@ -160,52 +161,80 @@ def _cost_row(cl, crrev, gl, gr, vol, pl, prrev, term, y, dmin, crow, cs):
     far = np.uint16(term[0])
     ch = pl.shape[0]
     kcap = np.uint16(min(term[1], 0xFFFF))
-    narrow = term[1] * term[2] + term[3] < 0x10000
-    for x in range(w):
-        a = lrow[x]
-        base = w - 1 - x + dmin
-        r = rrev[base:base + nd]
-        c = crow[x]
-        if ch == 0:
-            for j in range(nd):
-                c[j] = np.uint16(_popcount(a ^ r[j]))
-        else:
-            _term_row(pl, prrev, y, x, base, c, nd, kcap, term, narrow)
-            for j in range(nd):
-                c[j] = c[j] + np.uint16(_popcount(a ^ r[j]))
-        for j in range(max(0, x - dmin + 1), nd):
-            c[j] = far
+    narrow = ch == 3 and term[4] == NARROW_SHIFT and term[1] * term[2] + term[3] < 0x10000
+    ta, tb = np.uint16(term[2] & 0xFFFF), np.uint16(term[3] & 0xFFFF)
+    # one loop over x per case, each with only its own inner loops: with the three cases'
+    # loops in one x loop the defaults' row took 13.4 ms a 640x480/64 image, alone 7 ms
+    if ch == 0:
+        for x in range(w):
+            _hamming(lrow, rrev, x, dmin, crow[x], far, False)
+    elif narrow:
+        for x in range(w):
+            _term_row3(pl, prrev, y, x, w - 1 - x + dmin, crow[x], nd, kcap, ta, tb)
+            _hamming(lrow, rrev, x, dmin, crow[x], far, True)
+    else:
+        for x in range(w):
+            _term_row(pl, prrev, y, x, w - 1 - x + dmin, crow[x], nd, kcap, term)
+            _hamming(lrow, rrev, x, dmin, crow[x], far, True)
 
 
 @njit(cache=True, fastmath=True, inline="always")
-def _term_row(pl, prrev, y, x, base, c, nd, kcap, term, narrow):
-    """The intensity term of left pixel x's candidates into c (see _cost_row): each channel's
-    |difference| as max - min of the uint8 levels, summed in uint16 (at most 3 x 255), capped,
-    then scaled in uint16 lanes (narrow) or uint32."""
-    ch = pl.shape[0]
+def _hamming(lrow, rrev, x, dmin, c, far, add):
+    """The census Hamming distances of left pixel x's candidates into c (added to it: add),
+    far where the right pixel is outside the image (see _cost_row)."""
+    nd = c.shape[0]
+    a = lrow[x]
+    base = lrow.shape[0] - 1 - x + dmin
+    r = rrev[base:base + nd]
+    if add:
+        for j in range(nd):
+            c[j] = c[j] + np.uint16(_popcount(a ^ r[j]))
+    else:
+        for j in range(nd):
+            c[j] = np.uint16(_popcount(a ^ r[j]))
+    for j in range(max(0, x - dmin + 1), nd):
+        c[j] = far
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _term_row(pl, prrev, y, x, base, c, nd, kcap, term):
+    """The intensity term of left pixel x's candidates into c (see _cost_row), uint32 lanes:
+    each channel's |difference| as max - min of the uint8 levels, summed, capped, scaled."""
     q0 = prrev[0, y, base:base + nd]
+    q1 = prrev[min(1, pl.shape[0] - 1), y, base:base + nd]
+    q2 = prrev[min(2, pl.shape[0] - 1), y, base:base + nd]
     l0 = pl[0, y, x]
-    if ch == 1:
-        for j in range(nd):
-            c[j] = min(np.uint16(max(l0, q0[j]) - min(l0, q0[j])), kcap)
-    else:
-        q1 = prrev[1, y, base:base + nd]
-        q2 = prrev[2, y, base:base + nd]
-        l1 = pl[1, y, x]
-        l2 = pl[2, y, x]
-        for j in range(nd):
-            k = np.uint16(np.uint16(max(l0, q0[j]) - min(l0, q0[j]))
+    l1 = pl[min(1, pl.shape[0] - 1), y, x] if pl.shape[0] == 3 else np.uint8(0)
+    l2 = pl[min(2, pl.shape[0] - 1), y, x] if pl.shape[0] == 3 else np.uint8(0)
+    n3 = np.uint8(255) if pl.shape[0] == 3 else np.uint8(0)
+    wa, wb, ws = np.uint32(term[2]), np.uint32(term[3]), np.uint32(term[4])
+    for j in range(nd):
+        k = min(np.uint32(max(l0, q0[j]) - min(l0, q0[j]))
+                + np.uint32(max(l1, q1[j] & n3) - min(l1, q1[j] & n3))
+                + np.uint32(max(l2, q2[j] & n3) - min(l2, q2[j] & n3)), np.uint32(kcap))
+        c[j] = np.uint16((k * wa + wb) >> ws)
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _term_row3(pl, prrev, y, x, base, c, nd, kcap, ta, tb):
+    """_term_row for three channels in uint16 lanes, where the term is (min(k, kcap) * ta +
+    tb) >> 8 in 16 bits (NARROW_SHIFT; the defaults' form): a constant shift and one loop
+    alone in its branch, which LLVM vectorises at 32 lanes (with the general loop beside it
+    the row took twice as long)."""
+    q0 = prrev[0, y, base:base + nd]
+    q1 = prrev[1, y, base:base + nd]
+    q2 = prrev[2, y, base:base + nd]
+    l0 = pl[0, y, x]
+    l1 = pl[1, y, x]
+    l2 = pl[2, y, x]
+    for j in range(nd):
+        k = min(np.uint16(np.uint16(max(l0, q0[j]) - min(l0, q0[j]))
                           + np.uint16(max(l1, q1[j]) - min(l1, q1[j]))
-                          + np.uint16(max(l2, q2[j]) - min(l2, q2[j])))
-            c[j] = min(k, kcap)
-    if narrow:
-        ta, tb, ts = np.uint16(term[2]), np.uint16(term[3]), np.uint16(term[4])
-        for j in range(nd):
-            c[j] = np.uint16(np.uint16(c[j] * ta) + tb) >> ts
-    else:
-        wa, wb, ws = np.uint32(term[2]), np.uint32(term[3]), np.uint32(term[4])
-        for j in range(nd):
-            c[j] = np.uint16((np.uint32(c[j]) * wa + wb) >> ws)
+                          + np.uint16(max(l2, q2[j]) - min(l2, q2[j]))), kcap)
+        c[j] = np.uint16(np.uint16(k * ta) + tb) >> np.uint16(NARROW_SHIFT)
+
+
+NARROW_SHIFT = 8  # the shift of the intensity term's 16-bit form (cost.integer_term)
 
 
 @njit(cache=True)
