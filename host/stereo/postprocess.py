@@ -61,9 +61,29 @@ def fill_background(disp: np.ndarray) -> np.ndarray:
 
 
 def median(disp: np.ndarray, size: int) -> np.ndarray:
-    """Median filter (size 3 or 5) that keeps NaN where the input had no disparity."""
-    invalid = np.isnan(disp)
-    filled = np.where(invalid, 0.0, disp).astype(np.float32)
-    out = cv2.medianBlur(filled, size)
-    out[invalid] = np.nan
+    """Median filter (size 3 or 5) that keeps NaN where the input had no disparity (which
+    counts as 0 in its neighbours' medians). A map of whole pixels in 0 .. 65535 (SGM's
+    defaults) is filtered as uint16: the same order statistics, a fifth of float32's time."""
+    whole = np.empty(disp.shape, dtype=np.uint16)
+    src: np.ndarray = whole
+    if not _as_whole(np.ascontiguousarray(disp), whole):
+        src = np.where(np.isnan(disp), 0.0, disp).astype(np.float32)
+    out = cv2.medianBlur(src, size).astype(np.float32, copy=False)
+    out[np.isnan(disp)] = np.nan
     return out
+
+
+@njit(cache=True)
+def _as_whole(disp: np.ndarray, out: np.ndarray) -> bool:
+    """disp into out (uint16, NaN as 0); whether every valid value is a whole number in
+    0 .. 65535 (out is only meaningful then). No early exit, so the loop runs in vector
+    lanes (a third of the time of one that stops at the first miss)."""
+    flat, o = disp.ravel(), out.ravel()
+    ok = True
+    for i in range(flat.size):
+        v = flat[i]
+        valid = not np.isnan(v)
+        whole = v >= 0.0 and v <= 65535.0 and v == np.floor(v)
+        ok &= whole or not valid
+        o[i] = np.uint16(v) if whole else np.uint16(0)
+    return ok
