@@ -783,6 +783,8 @@ class Servo:
         if acq.done:
             assert self.controller is not None and acq.facing_away is not None
             self.controller.facing_away = acq.facing_away
+            if acq.probes:  # its move showed the facing beyond the depth noise (acquire.py)
+                self.heading.way = 1 if acq.facing_away else -1
             if not acq.facing_away and acq.probes:
                 self.notes.append("the probe move showed that the robot faces the camera")
         return Command(order.left, order.right, order.phase, None)
