@@ -101,10 +101,10 @@ class ControlConfig:
     # glimpse of it, the turn ended short, does not end the search)
     lost_frames: int = 3
     # a turn that ended on the card's sweep is half a turn only when one edge-on pass accounts
-    # for the card's absence: the rate over the gap at least this share of the rate seen
-    # while the card turned from square to its loss (that one over at least half_min_deg)
+    # for the card's absence: the rate over the gap at least this share of the rate from the
+    # turn's start to the card's loss (that one over at least half_min_deg; _one_pass)
     half_share: float = 0.6
-    half_min_deg: float = 15.0
+    half_min_deg: float = 10.0
 
 
 @dataclass(frozen=True)
@@ -459,19 +459,21 @@ class Controller:
     def _one_pass(self, turn: dict[str, Any], rate: float) -> bool:
         """Whether one edge-on pass accounts for the card's absence in this turn: the card is
         two-sided, so the same sweep ends half a turn and, had the card been missed (hidden,
-        frames lost) through its square view between two passes, a turn and a half. The rate
-        over the gap is then about a third of the turn's: it must reach half_share of the
-        rate seen from the card nearest square to its loss (that one is low, if anything: the
-        spin starts from rest), over at least half_min_deg, or the half turn is not shown."""
+        frames lost) through its square view between two passes, a turn and a half: the
+        rate over the gap is then about a third of the spin's. It must reach half_share of
+        the rate from the turn's start to the loss (the card's angle at the start the median
+        of its first three aspects: far away one reads square amid 20-25 degree ones), that
+        over at least half_min_deg; that rate is low, if anything (the spin starts from
+        rest), so a slow start makes this check lenient, never a real half turn refused."""
         cfg, lost_t = self.cfg, turn["lost_t"]
-        before = [(t, a) for t, a in turn["seen"] if t < lost_t]
-        if not before:
+        first = [a for t, a in turn["seen"] if t < lost_t][:3]
+        if not first or lost_t <= turn["t0"]:
             return False
-        t_sq, a_sq = max(before, key=lambda s: s[1])
-        angle = math.acos(min(1.0, turn["lost_aspect"])) - math.acos(min(1.0, a_sq))
-        if angle < math.radians(cfg.half_min_deg) or lost_t <= t_sq:
+        start = math.acos(min(1.0, float(np.median(first))))
+        angle = math.acos(min(1.0, turn["lost_aspect"])) - start
+        if angle < math.radians(cfg.half_min_deg):
             return False
-        return rate >= cfg.half_share * angle / (lost_t - t_sq)
+        return rate >= cfg.half_share * angle / (lost_t - turn["t0"])
 
     def _end_turn(self, t: float) -> Command:
         if self._turn is not None and self._turn["half"]:
