@@ -108,3 +108,27 @@ def test_a_card_missed_through_its_square_view_does_not_show_half_a_turn() -> No
 def test_a_turn_that_ends_on_its_timeout_shows_nothing() -> None:
     ctl, plant, marks = turn_round(hidden=(30.0, math.inf), seconds=10.0)
     assert ctl.phase == "search" and marks == []  # the card never came back: looked for
+
+
+def test_far_away_an_aspect_read_square_does_not_refuse_a_half_turn() -> None:
+    """Dev seed 3's trial 8 at 2.84 m: the card's angle read 21-24 degrees for 0.8 s of the
+    turn's start (the spin not yet under way), with a few frames read square (aspect 1) among
+    them, then lost at 39 degrees and back 1.45 s later at 40 degrees (1.22 rad/s over the
+    gap). Taken from the last square reading (5.47 s), the rate before the loss came out 2.6
+    rad/s, twice the spin's, and the half turn was refused; from the turn's start it is not."""
+    ctl = Controller(1.18, ControlConfig())
+    t, marks = 5.0, []
+    degs = (23, 24, 21, 21, 0, 21, 24, 23, 0, 0, 0, 13, 26, 39)
+    for k, deg in enumerate(degs):
+        t = 5.0 + 0.8 * k / (len(degs) - 1)
+        cmd = ctl.update(Observation(t, 2.84, 0.0, math.cos(math.radians(deg))))
+        assert cmd.phase == "turn"
+    back = t + math.radians(180 - 39 - 40) / 1.22
+    while t < back + 1.0:
+        t += 0.033
+        seen = t >= back
+        ctl.update(Observation(t, 2.84 if seen else None, 0.0,
+                               math.cos(math.radians(40)) if seen else 1.0))
+        if ctl.turned_half is not None:
+            marks.append(ctl.turned_half)
+    assert not ctl.facing_away and marks == [5.0]
