@@ -118,7 +118,7 @@ def test_far_away_an_aspect_read_square_does_not_refuse_a_half_turn() -> None:
     rad/s, twice the spin's, and the half turn was refused; from the turn's start it is not."""
     ctl = Controller(1.18, ControlConfig())
     t, marks = 5.0, []
-    degs = (23, 24, 21, 21, 0, 21, 24, 23, 0, 0, 0, 13, 26, 39)
+    degs = (23, 24, 21, 21, 2, 21, 24, 23, 0, 0, 0, 13, 26, 39)
     for k, deg in enumerate(degs):
         t = 5.0 + 0.8 * k / (len(degs) - 1)
         cmd = ctl.update(Observation(t, 2.84, 0.0, math.cos(math.radians(deg))))
