@@ -180,13 +180,18 @@ class Heading:
         self.spread = math.pi  # how far off it may be (rad)
         self._run: deque[tuple[float, float, float]] = deque()  # (t, z, x) driven one way
         self._sign = 0
+        self._spin_t0: float | None = None  # the first update of the spin in force, if any
+        self._before = 0  # the way shown when that spin began
 
     def update(self, t: float, z: float, x: float, left: int, right: int,
                noise_m: float) -> float | None:
         if left * right < 0 or (left == 0) != (right == 0):  # a spin, or one wheel alone
+            if self._spin_t0 is None:  # it begins: the way is kept aside for a turned_round
+                self._spin_t0, self._before = t, self.way
             self.value, self.spread, self._sign, self.way = None, math.pi, 0, 0
             self._run.clear()
             return None
+        self._spin_t0 = None  # a spin's end not witnessed (turned_round): its way is forgotten
         sign = (left > 0) - (left < 0)
         if sign == 0:  # standing: the heading stays (a push moves it, but does not turn it)
             self._sign = 0
@@ -210,6 +215,16 @@ class Heading:
                 self.spread = spread
         self._turning(sign, noise_m)
         return self.value
+
+    def turned_round(self, since: float) -> None:
+        """The spin in force was a turn round begun at `since` (its command given then) and
+        witnessed to end half a turn on (controller.py: the card passed edge-on once, at a rate
+        that one pass accounts for): the way shown before it holds reversed. A spin that began
+        before `since` (a search, a spin back) turned the robot by an angle nobody saw: its
+        way stays forgotten; so does one already ended, or no spin at all."""
+        if self._spin_t0 is not None and self._spin_t0 > since:
+            self.way = -self._before
+        self._spin_t0, self._before = None, 0
 
     def _turning(self, sign: int, noise_m: float) -> None:
         """Where the run's two halves point ways that differ by more than twice the later

@@ -100,6 +100,11 @@ class ControlConfig:
     steady_frames: int = 10  # the card seen this many frames running after a turn: found (a
     # glimpse of it, the turn ended short, does not end the search)
     lost_frames: int = 3
+    # a turn that ended on the card's sweep is half a turn only when one edge-on pass accounts
+    # for the card's absence: the rate over the gap at least this share of the rate from the
+    # turn's start to the card's loss (that one over at least half_min_deg; _one_pass)
+    half_share: float = 0.6
+    half_min_deg: float = 10.0
 
 
 @dataclass(frozen=True)
@@ -154,6 +159,9 @@ class Controller:
         self._search_until: float | None = None
         self._seen_run = 0  # frames the card has been seen running
         self._reversing = False  # this leg is reversed: a turn would sweep into the object
+        # this frame a turn round ended, witnessed half a turn (the card's sweep, at a rate one
+        # edge-on pass accounts for): when its spin was commanded (s); else None
+        self.turned_half: float | None = None
 
     # ---------------------------------------------------------------------- estimates
 
@@ -291,6 +299,7 @@ class Controller:
         return x0 - reach < lateral < x1 + reach
 
     def update(self, obs: Observation) -> Command:
+        self.turned_half = None
         if self.fault:
             return self._stop(Phase.BLOCKED, None)
         if self._turn is not None:
@@ -405,7 +414,8 @@ class Controller:
     def _start_turn(self, obs: Observation, e: float) -> Command:
         self._seen_run = 0  # the card seen after the turn counts afresh
         self._turn = {"t0": obs.t, "lost_t": None, "lost_aspect": 1.0, "end": None,
-                      "last_seen": (obs.t, obs.aspect)}
+                      "last_seen": (obs.t, obs.aspect), "seen": [(obs.t, obs.aspect)],
+                      "half": False}
         return self._spin(e)
 
     def _spin(self, e: float | None) -> Command:
@@ -426,12 +436,14 @@ class Controller:
             return self._end_turn(obs.t)  # the card never came back: look for it
         if seen and turn["lost_t"] is None:
             turn["last_seen"] = (obs.t, obs.aspect)
+            turn["seen"].append((obs.t, obs.aspect))
         elif not seen and turn["lost_t"] is None and not obs.invalid:
             turn["lost_t"], turn["lost_aspect"] = turn["last_seen"]
         elif seen and turn["lost_t"] is not None and obs.t - turn["lost_t"] < cfg.min_gap_s:
             # back within min_gap_s: a missed detection, not the card's back; forget the loss,
             # or a later sighting (min_gap_s after it) would end the turn there
             turn["lost_t"], turn["last_seen"] = None, (obs.t, obs.aspect)
+            turn["seen"].append((obs.t, obs.aspect))
         elif seen and turn["lost_t"] is not None:
             a_lost = min(1.0, turn["lost_aspect"])
             a_now = min(1.0, obs.aspect)
@@ -439,11 +451,33 @@ class Controller:
             rate = swept / max(obs.t - turn["lost_t"], 1e-3)
             remaining = math.acos(a_now) / rate - self.cfg.stop_lead_s
             turn["end"] = obs.t + max(0.0, remaining)
+            turn["half"] = self._one_pass(turn, rate)
             if remaining <= 0:
                 return self._end_turn(obs.t)
         return self._spin(None)
 
+    def _one_pass(self, turn: dict[str, Any], rate: float) -> bool:
+        """Whether one edge-on pass accounts for the card's absence in this turn: the card is
+        two-sided, so the same sweep ends half a turn and, had the card been missed (hidden,
+        frames lost) through its square view between two passes, a turn and a half: the
+        rate over the gap is then about a third of the spin's. It must reach half_share of
+        the rate from the turn's start to the loss (the card's angle at the start the median
+        of its first three aspects: far away one reads square amid 20-25 degree ones), that
+        over at least half_min_deg; that rate is low, if anything (the spin starts from
+        rest), so a slow start makes this check lenient, never a real half turn refused."""
+        cfg, lost_t = self.cfg, turn["lost_t"]
+        first = [a for t, a in turn["seen"] if t < lost_t][:3]
+        if not first or lost_t <= turn["t0"]:
+            return False
+        start = math.acos(min(1.0, float(np.median(first))))
+        angle = math.acos(min(1.0, turn["lost_aspect"])) - start
+        if angle < math.radians(cfg.half_min_deg):
+            return False
+        return rate >= cfg.half_share * angle / (lost_t - turn["t0"])
+
     def _end_turn(self, t: float) -> Command:
+        if self._turn is not None and self._turn["half"]:
+            self.turned_half = self._turn["t0"]
         self._turn = None
         # the card not back after the turn (it never came back, or the turn ended edge-on: an
         # occluded card misread the angle): spin on to find it, whenever it goes missing

@@ -1210,6 +1210,8 @@ class Servo:
             g = self.geometry
             self.heading.update(t, s.z, s.x, self._cmd.left, self._cmd.right, depth_noise_m(
                 s.z, self.estimator.sigma_px, g.focal_px, g.baseline_m))
+        if c.turned_half is not None:  # a turn round witnessed half a turn (controller.py)
+            self.heading.turned_round(c.turned_half)  # the way shown before it, reversed
         if not self._cmd.is_stop:
             self._still_since = None
         elif self._still_since is None:
