@@ -473,7 +473,7 @@ class Controller:
         angle = math.acos(min(1.0, turn["lost_aspect"])) - start
         if angle < math.radians(cfg.half_min_deg):
             return False
-        return rate >= cfg.half_share * angle / (lost_t - turn["t0"])
+        return bool(rate >= cfg.half_share * angle / (lost_t - turn["t0"]))
 
     def _end_turn(self, t: float) -> Command:
         if self._turn is not None and self._turn["half"]:
