@@ -695,13 +695,19 @@ class Servo:
         hit = run_fault(cells, s.z, s.x, cmd.left, cmd.right, h, spread, travel, body,
                         self.cfg.wheelbase_m)
         what = "probe" if cmd.phase == Phase.PROBE else "reversed leg" if back else "drive"
-        if hit is None and cmd.phase != Phase.PROBE and not facing_shown(self.heading,
-                                                                         c.facing_away):
+        # the probe's second leg (far away, its first leg's move within the noise) runs back
+        # through the start and as far beyond it: facing the other way, it goes where neither
+        # leg's check along the facing looked (the first leg's covered its start's run-down
+        # alone), so it is checked the other way too, within its own travel (it is stopped,
+        # as here, the frame it comes within that): acquire.py, Acquisition.second_leg
+        second = cmd.phase == Phase.PROBE and self.acquisition.second_leg
+        if hit is None and (cmd.phase != Phase.PROBE or second) and not facing_shown(
+                self.heading, c.facing_away):
             # facing the other way, it runs on until its travel shows the way (Heading.way),
             # then stops within the same stopping distance
             g = self.geometry
-            show = self.heading.way_sigmas * depth_noise_m(s.z, est.sigma_px, g.focal_px,
-                                                            g.baseline_m)
+            show = 0.0 if second else self.heading.way_sigmas * depth_noise_m(
+                s.z, est.sigma_px, g.focal_px, g.baseline_m)
             hit = run_fault(cells, s.z, s.x, cmd.left, cmd.right, h + math.pi, spread,
                             travel + show, body, self.cfg.wheelbase_m)
             if hit is not None:  # a facing the travel has not shown: it may be the other
