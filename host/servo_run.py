@@ -47,8 +47,9 @@ def run_servo(servo: Servo, rules: Rules, clock: Callable[[], float],
     each(row): called after every step (notes, a status line). Errors of the link or the camera
     leave as exceptions; the caller's link context sends STOP."""
     t0 = clock()
-    if rules.limit_s is not None:  # a wait still on near it ends the run named (Servo._too_late)
-        servo.deadline = t0 + rules.limit_s
+    # a wait still on near it ends the run named (Servo._too_late); a run without a limit has
+    # no deadline, not the one a run before it on this servo had
+    servo.deadline = None if rules.limit_s is None else t0 + rules.limit_s
     lost_since: float | None = None
     while True:
         try:

@@ -14,7 +14,8 @@ way the robot faces by what a short probe move does (a pure state machine, one c
              the way it faces follows from the sign of that move; nothing moved by probe_s:
              the run stops with that reason; moved within the noise by probe_s (far away):
              the second leg, back the other way through the start and as far beyond it
-             (back_factor times the first's time), decides on its own move beyond the noise,
+             (each of the first's duties held back_factor times as long), decides on its
+             own move beyond the noise,
              else the run stops (UNSHOWN), never on the sign of a move within the noise
              (seed 12's trial 246 at 3 m); the marker unseen for
              probe_gap_s (the robot stands): the probe's clock stops meanwhile, but for the
@@ -68,8 +69,9 @@ class AcquireConfig:
     floor_px: float = 0.1  # a sighting's disparity noise at least (px): far sightings err
     # together for many frames, by 0.23-0.25 px in jumps (seed 12 #246, seed 11 #117 at 3 m),
     # which the measure's few standing frames do not show
-    back_factor: float = 2.0  # the second leg's time, of the first's driving (back through
-    # the start and as far beyond it: the robot stays within the first leg's reach of it)
+    back_factor: float = 2.0  # the second leg's time at each of the first's duties, of the
+    # first's (back through the start and as far beyond it: the robot stays within the first
+    # leg's reach of it, as the first leg's own time at each duty sets its travel)
 
 
 @dataclass(frozen=True)
@@ -106,6 +108,9 @@ class Acquisition:
         self._disp: list[float] = []  # the track's disparities (px)
         self._leg = 1  # the probe's first leg, or its second, back the other way
         self._back_s = 0.0  # the second leg's time (s)
+        self._levels: dict[int, float] = {}  # the first leg's time at each duty (s)
+        self._back: dict[int, float] = {}  # the second leg's so far
+        self._drive: tuple[float, int] | None = None  # the last drive order: (t, |duty|)
         self.direction = 1  # the probe's: +1 forward, -1 backward (set by the servo)
         self._seen_t = -math.inf  # the last sighting's time
         self.spent_s = spent_s  # the probe's driving before its last start (s)
@@ -113,6 +118,12 @@ class Acquisition:
     @property
     def done(self) -> bool:
         return self.phase == Phase.DONE
+
+    @property
+    def second_leg(self) -> bool:
+        """The probe is on its second leg (back through its start and beyond it): its facing
+        not shown by the first, it may run either way."""
+        return self.phase == Phase.PROBE and self._leg == 2
 
     def update(self, t: float, position: tuple[float, float] | None,
                disparity: float | None, noise_m: float = 0.0) -> Order:
@@ -163,6 +174,7 @@ class Acquisition:
                 self._after.clear()
             self._track.clear()
             self._disp.clear()
+            self._drive = None  # the robot stands from this frame: its time is not driven
             self._t0 = None  # the phase's clock starts again at the next usable frame
 
     def _begin(self, phase: Phase, t: float) -> None:
@@ -200,6 +212,11 @@ class Acquisition:
         cfg = self.cfg
         if self._after is not None:
             return self._standing_after(t, position, noise_m)
+        if self._drive is not None:  # the last drive order was in force until now
+            t1, level = self._drive
+            ledger = self._levels if self._leg == 1 else self._back
+            ledger[level] = ledger.get(level, 0.0) + t - t1
+            self._drive = None
         if position is None or disparity is None:
             return Order(0, 0, Phase.PROBE)  # not seen: stand until it is
         gap = t - (self._track[-1][0] if self._track else self._t0)
@@ -215,7 +232,9 @@ class Acquisition:
         self._track.append((t, *position))
         self._disp.append(disparity)
         limit = cfg.probe_s if self._leg == 1 else self._back_s
-        late, moved, dz = t - self._t0 > limit, 0.0, 0.0
+        duty = self._back_duty() if self._leg == 2 else 0
+        late = t - self._t0 > limit if self._leg == 1 else duty == 0
+        moved, dz = 0.0, 0.0
         # started again: its clock in all is bounded too; up, it decides on what it has seen
         # since the last start (at least ten sightings, as ever), or stops without them
         out = self.spent_s > 0 and self.spent_s + t - self._t0 > limit
@@ -252,8 +271,11 @@ class Acquisition:
             return Order(0, 0, Phase.PROBE)
         if late and self._leg == 1:
             # within the noise (far away): back the other way, through the start and as far
-            # beyond it, a move twice the first's in the robot's reach of its start
+            # beyond it, a move twice the first's in the robot's reach of its start: each
+            # duty of the first leg held back_factor times as long (_back_duty), so the robot's
+            # travel, whatever its speed at each duty, is back_factor times the first leg's
             self._back_s = cfg.back_factor * self.driven_s()
+            self._back = {}
             self._leg, self.direction, self.spent_s = 2, -self.direction, 0.0
             self._track.clear()
             self._disp.clear()
@@ -263,10 +285,23 @@ class Acquisition:
             self.fault = UNSHOWN.format(position[0], 100 * 3 * self._noise(
                 position[0], disparity, noise_m))
             return Order(0, 0, Phase.PROBE)
-        duty = min(cfg.max_probe_duty,
-                   cfg.probe_duty + cfg.probe_step * int((t - self._t0) / cfg.probe_step_s))
+        if self._leg == 1:
+            duty = min(cfg.max_probe_duty,
+                       cfg.probe_duty + cfg.probe_step * int((t - self._t0) / cfg.probe_step_s))
+        self._drive = (t, duty)
         duty *= self.direction
         return Order(duty, duty, Phase.PROBE)
+
+    def _back_duty(self) -> int:
+        """The second leg's duty now: the first leg's duties in rising order, each until it
+        has been held back_factor times the first leg's time at it; 0 when all have (the leg
+        is over). Timed in seconds from a ramp begun again, the second leg held its top duty
+        longest and ran 2.1 times the first leg's duty-time, beyond the start by more than
+        the first leg's reach (the reviewer's measure of 979f477: 1150 against 550)."""
+        for level in sorted(self._levels):
+            if self._back.get(level, 0.0) < self.cfg.back_factor * self._levels[level] - 1e-9:
+                return level
+        return 0
 
     def _standing_after(self, t: float, position: tuple[float, float] | None,
                         noise_m: float) -> Order:

@@ -26,9 +26,11 @@ too short for that noise gives none; kept while it stands, forgotten when it spi
 angle is known only roughly). Not known, a run is checked along the controller's facing
 (motion_heading). That facing is a belief until the travel shows it (Heading.way: a straight
 run's depth moved the commanded way beyond three of its noise over at least 0.5 s); a probe's
-verdict at probe_s is the sign of a move within the noise. Not shown, a drive or a reversed
-leg is checked the other way too, on for as far as the travel needs to show the way
-(facing_shown; seed 12 trial 246: at 3 m a verdict on a wild sighting had the
+verdict rests on a move beyond the noise at its range (acquire.py: within it by probe_s, far
+away, a second leg back through the start decides, else the run stops), and a probed
+acquisition sets the way (Servo). Not shown, a drive or a reversed leg is checked the other
+way too, on for as far as the travel needs to show the way, and so is the probe's second leg
+within its own travel (facing_shown; seed 12 trial 246: at 3 m a verdict on a wild sighting had the
 robot face the camera; it faced the back wall 20 cm behind, drove 10 cm toward it before the
 motion check turned it round, and the turn's circle hit the wall).
 """

@@ -6,8 +6,11 @@ State: depth z and lateral position x (m, camera frame: z along the optical axis
 right) and their rates, on each axis the steady-state Kalman filter of a constant rate (an
 alpha-beta filter with the gains of Kalata's tracking index, `gains`) on the sightings it
 accepts, weighed by each sighting's own noise on that axis: the depth's grows as z^2 (3.5 cm
-at 3 m, 0.8 cm at 1.4 m for 0.1 px), the lateral position's, from the image column, is a
-tenth of that or less, so x follows its sightings closely while a far depth is smoothed (with
+at 3 m, 0.8 cm at 1.4 m for 0.1 px), the lateral position's, from the image column, grows
+as z too but with the bearing: sqrt(B^2/2 - x B + x^2) / z of the depth's, at least 1 mm
+(noise_m; at 0.1 px on the 320x240 rig: 0.03 of it on the axis at 3 m, 0.06 at 2 m, 0.13 at
+1.4 m and 0.18 at 1.2 m by the floor, 0.15-0.19 half-way to the picture's edge and 0.31-0.36
+near it), so x follows its sightings more closely than a far depth, which is smoothed (with
 one gain pair for both, x lagged and the far depth's rate was its noise); the motion model's
 acceleration is the command's: a drive's starts and stops, or, told to stand for run_down_s,
 a push's slow onset alone. The gate of a new
@@ -108,11 +111,14 @@ class Estimator:
 
     def noise_m(self, z: float, x: float) -> tuple[float, float]:
         """A sighting's noise (m, one sd) in depth and laterally at (z, x), from the
-        disparity's sigma_px: depth z^2 sigma / (f B); lateral x = B (u - cx) / d from a column
-        with half the disparity's variance and the disparity's own, at least lateral_floor_m."""
+        disparity's sigma_px: depth z^2 sigma / (f B); lateral x = B (uL - cx) / d with
+        d = uL - uR, the two columns' errors apart and each of half the disparity's variance
+        (u and d are not independent: x's sd is z sigma / f sqrt(0.5 - x/B + (x/B)^2)), at
+        least lateral_floor_m."""
         g, sd = self.g, self.sigma_px
         depth = z * z * sd / (g.focal_px * g.baseline_m)
-        lateral = z * sd / g.focal_px * math.sqrt(0.5 + (x / g.baseline_m) ** 2)
+        r = x / g.baseline_m
+        lateral = z * sd / g.focal_px * math.sqrt(0.5 - r + r * r)
         return depth, max(self.cfg.lateral_floor_m, lateral)
 
     def position(self, s: Sighting) -> tuple[float, float]:

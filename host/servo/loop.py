@@ -695,13 +695,19 @@ class Servo:
         hit = run_fault(cells, s.z, s.x, cmd.left, cmd.right, h, spread, travel, body,
                         self.cfg.wheelbase_m)
         what = "probe" if cmd.phase == Phase.PROBE else "reversed leg" if back else "drive"
-        if hit is None and cmd.phase != Phase.PROBE and not facing_shown(self.heading,
-                                                                         c.facing_away):
+        # the probe's second leg (far away, its first leg's move within the noise) runs back
+        # through the start and as far beyond it: facing the other way, it goes where neither
+        # leg's check along the facing looked (the first leg's covered its start's run-down
+        # alone), so it is checked the other way too, within its own travel (it is stopped,
+        # as here, the frame it comes within that): acquire.py, Acquisition.second_leg
+        second = cmd.phase == Phase.PROBE and self.acquisition.second_leg
+        if hit is None and (cmd.phase != Phase.PROBE or second) and not facing_shown(
+                self.heading, c.facing_away):
             # facing the other way, it runs on until its travel shows the way (Heading.way),
             # then stops within the same stopping distance
             g = self.geometry
-            show = self.heading.way_sigmas * depth_noise_m(s.z, est.sigma_px, g.focal_px,
-                                                            g.baseline_m)
+            show = 0.0 if second else self.heading.way_sigmas * depth_noise_m(
+                s.z, est.sigma_px, g.focal_px, g.baseline_m)
             hit = run_fault(cells, s.z, s.x, cmd.left, cmd.right, h + math.pi, spread,
                             travel + show, body, self.cfg.wheelbase_m)
             if hit is not None:  # a facing the travel has not shown: it may be the other
@@ -876,12 +882,7 @@ class Servo:
             cmd = self._decide(t, pair, position, seen.disparity, invalid)
             cmd, invalid = self._measured_first(t, cmd, invalid)
             cmd, invalid = self._watch_lane(frame, t, cmd, invalid)
-        stalled = self.progress.update(t, cmd.phase, cmd.error_m, self.target_m,
-                                       waiting=bool(waiting) or self.recovery.active)
-        stalled = stalled or self._too_late()
-        if stalled and not self.stop_reason:  # STOP now: the run ends with this step
-            self.stop_reason = stalled
-            self.notes.append(f"{stalled}: {self.progress.detail()}")
+        if self._stalled(t, cmd, bool(waiting)):  # STOP now: the run ends with this step
             cmd = Command(0, 0, Phase.STOP, cmd.error_m)
         t_send = time.perf_counter()
         self._send(cmd, t)
@@ -972,6 +973,20 @@ class Servo:
                             keep_estimate=True)
             return Command(0, 0, Phase.FIND, None)
         return Command(left, right, Phase.SEARCH, None)
+
+    def _stalled(self, t: float, cmd: Command, waiting: bool) -> bool:
+        """Whether the run ends with this step, for no progress for long (progress.py) or a
+        wait still on at the run's deadline (_too_late), named in stop_reason and the notes;
+        what the servo did since its last progress is noted when that was the cause (a wait
+        at the deadline is its own account)."""
+        stalled = self.progress.update(t, cmd.phase, cmd.error_m, self.target_m,
+                                       waiting=waiting or self.recovery.active)
+        late = "" if stalled else self._too_late()
+        if not (stalled or late) or self.stop_reason:
+            return False
+        self.stop_reason = stalled or late
+        self.notes.append(f"{stalled}: {self.progress.detail()}" if stalled else late)
+        return True
 
     def _too_late(self) -> str:
         """A wait (recovery.py) still on LATE_S before the run's deadline: the run ends as the

@@ -25,7 +25,7 @@ import cv2
 import numpy as np
 from numba import njit, prange
 
-from host.stereo.sgm import CENSUS_BITS, _popcount
+from host.stereo.sgm import CENSUS_BITS, NARROW_SHIFT, _popcount
 
 
 @njit(cache=True, parallel=True)
@@ -74,13 +74,13 @@ def integer_term(ch: int, weight: float, cap: int, outside: int) -> np.ndarray |
     term of a summed |difference| k is (min(k, kcap) * a + b) >> s, checked equal to
     term_table at every k (the row-by-row cost then equals census_ad_volume's); None where no
     such integers are found (the caller builds the volume instead). The smallest shift s that
-    works is taken, so that kcap * a + b mostly fits in 16 bits (_cost_row then scales in
-    uint16 lanes, twice as many as uint32)."""
+    works is taken, from sgm.NARROW_SHIFT up, so that kcap * a + b mostly fits in 16 bits
+    (_cost_row then scales in uint16 lanes, twice as many as uint32, at that shift)."""
     table = term_table(ch, weight, cap)
     kcap = ch * cap if cap < 255 else 255 * ch
     k = np.minimum(np.arange(256 * ch), kcap).astype(np.int64)
     largest = max(CENSUS_BITS + int(table.max()), outside)
-    for s in (8, 10, 12, 14, 16, 18, 20):
+    for s in range(NARROW_SHIFT, 21, 2):  # sgm's 16-bit form first (one source)
         a0 = int(round(weight / ch * (1 << s)))
         for a in (a0, a0 - 1, a0 + 1):
             for b in ((1 << s) // 2, (1 << s) // 2 - 1, (1 << s) // 2 + 1):

@@ -50,7 +50,7 @@ def test_a_far_probe_does_not_take_a_jump_of_its_sightings_for_the_move() -> Non
     assert acq.facing_away is not False, "a jump of the far sightings taken for the move"
     assert acq.done and acq.facing_away is True and not acq.fault, acq.fault
     first_leg = 3.0 - min(truth)
-    assert max(truth) - 3.0 <= first_leg + 0.01, (min(truth), max(truth))
+    assert max(truth) - 3.0 <= first_leg + 0.001, (min(truth), max(truth))
 
 
 def test_a_probe_whose_move_stays_within_the_noise_stops_named() -> None:
@@ -62,7 +62,7 @@ def test_a_probe_whose_move_stays_within_the_noise_stops_named() -> None:
     assert acq.facing_away is None and not acq.done, acq.facing_away
     assert acq.fault.startswith(UNSHOWN.split(":")[0]), acq.fault
     first_leg = max(truth) - 3.0  # backed away from the camera, then forward through the start
-    assert first_leg > 0.02 and 3.0 - min(truth) <= first_leg + 0.01, (min(truth), max(truth))
+    assert first_leg > 0.02 and 3.0 - min(truth) <= first_leg + 0.001, (min(truth), max(truth))
 
 
 def test_a_near_probe_decides_on_its_first_leg_as_before() -> None:

@@ -283,3 +283,29 @@ def test_a_drive_on_a_facing_its_travel_has_not_shown_is_checked_the_other_way_t
     assert scene.heading.value is None  # shown without a heading learnt
     assert _path(facing_camera(z, 0.05), drive).startswith(INTO_FIXED.format("drive"))
     assert _path(facing_camera(z - 0.19, None), drive) == ""
+
+
+def test_a_probes_second_leg_is_checked_the_other_way_too(scene: Servo) -> None:
+    """The probe's second leg (its first leg's move within the noise far away) runs back through
+    its start and as far beyond it. Facing the camera where the controller says away (its
+    default), the first leg backed away from the camera, and the second runs toward it, where
+    neither leg's check along the facing looked: at 2.55 m, 0.8 m right, 16 cm behind the
+    cells at 2.37-2.39 m (0.73-0.89 m right), forward at 400 the second leg is refused "if it
+    faces the other way" (979f477 drove it: a probe was checked along the facing alone). The
+    first leg's same order there is not (checking every probe both ways brought false stops
+    back), nor is the second leg's with the other way clear (2.80 m)."""
+    leg2 = Command(400, 400, Phase.PROBE, None)
+
+    def probing(z: float, leg: int) -> Servo:
+        servo = _at(scene, z, 0.8, None)
+        acq = servo.acquisition
+        acq.phase, acq._leg = Phase.PROBE, leg
+        return servo
+
+    try:
+        why = _path(probing(2.55, 2), leg2)
+        assert why.startswith(INTO_FIXED.format("probe")) and "other way" in why, why
+        assert _path(probing(2.55, 1), leg2) == ""
+        assert _path(probing(2.80, 2), leg2) == ""
+    finally:
+        scene.acquisition.phase, scene.acquisition._leg = Phase.DONE, 1

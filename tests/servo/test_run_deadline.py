@@ -6,7 +6,7 @@ past the trials' 45 s."""
 from __future__ import annotations
 
 from host.camera.geometry import Geometry
-from host.servo.controller import Controller
+from host.servo.controller import Command, Controller
 from host.servo.loop import LATE_S, Servo
 from host.servo.phase import Phase
 from host.servo.recovery import LANE
@@ -42,3 +42,19 @@ def test_no_wait_or_no_deadline_ends_nothing() -> None:
     servo = _servo(now)
     servo.recovery.begin(30.0, LANE, "an object in the lane 0.20 m ahead")
     assert servo._too_late() == ""  # no limit (a camera run): the wait's own bound
+
+
+def test_a_wait_at_the_deadline_is_noted_without_the_no_progress_account() -> None:
+    """The run ended by a wait at its deadline is noted as that wait, without progress.py's
+    "the least depth error ...; since then: ..." (an account of no progress, which says nothing
+    of the wait and was not the cause: 979f477 added it to every such note)."""
+    now = [30.0]
+    servo = _servo(now)
+    servo.deadline = 45.0
+    assert servo.recovery.begin(now[0], LANE, "an object in the lane 0.20 m ahead")
+    wait = Command(0, 0, Phase.WAIT, None)
+    assert not servo._stalled(now[0], wait, True) and not servo.notes
+    now[0] = 45.0 - LATE_S
+    assert servo._stalled(now[0], wait, True)
+    assert servo.stop_reason.startswith("an object in the lane 0.20 m ahead: still waiting")
+    assert servo.notes == [servo.stop_reason], servo.notes

@@ -15,7 +15,7 @@ from host.stereo.cost import (
     reversed_planes,
     term_table,
 )
-from host.stereo.params import CENSUS_BITS
+from host.stereo.params import CENSUS_BITS, MATCHER_DEFAULTS
 from host.stereo.synthetic import synthetic_scene
 
 
@@ -179,3 +179,17 @@ def test_matcher_defaults_take_the_cost_row_by_row() -> None:
     p = MatcherParams.for_matcher("sgm")
     assert integer_term(3, p.intensity_weight, p.intensity_cap, p.outside_cost) is not None
     assert integer_term(1, p.intensity_weight, p.intensity_cap, p.outside_cost) is not None
+
+
+def test_the_defaults_term_takes_the_narrow_16_bit_path() -> None:
+    """The own SGM's defaults (MATCHER_DEFAULTS) on three channels give the intensity term at
+    sgm.NARROW_SHIFT, within 16 bits: sgm._cost_row's uint16 lanes (_term_row3), not the
+    uint32 ones. integer_term tries that shift first, named once (sgm.NARROW_SHIFT); 979f477
+    tried a literal 8 first, so a NARROW_SHIFT changed alone would silently leave the defaults
+    on the wide path."""
+    d = MATCHER_DEFAULTS["sgm"]
+    term = integer_term(3, float(d["intensity_weight"]), d["intensity_cap"], d["outside_cost"])
+    assert term is not None
+    outside, kcap, a, b, shift, _ = (int(v) for v in term)
+    assert shift == sgm.NARROW_SHIFT, term
+    assert kcap * a + b < 0x10000, term  # the condition sgm._cost_row takes it on
