@@ -234,17 +234,19 @@ class Controller:
             cells = cells[~own_body(cells, z, x, own_m, cfg.half_width_m / 2, 2 * cfg.cell_m)]
         return cells
 
-    def sweeps(self, depth_m: float, lateral_m: float | None) -> bool:
+    def sweeps(self, depth_m: float, lateral_m: float | None, aged: bool = False) -> bool:
         """Whether a turn in place here sweeps the body (a circle of turn_radius_m) within
         block_margin_m of the object's extent or of any other fixed object's cell, behind the
         robot as well as ahead (a turn sweeps the whole circle: a box a few cm farther than the
         robot's centre is as near as one in its path), but not a body standing there
-        (obstacles: the sighting is then of a look-alike)."""
+        (obstacles: the sighting is then of a look-alike). aged: the object's depth is too old
+        to trust (not measured again through a search; it may have moved beside the robot
+        unseen, seed 13's trial 742): its extent across is swept at any depth."""
         if lateral_m is None:
             return False
         cfg = self.cfg
         reach = cfg.turn_radius_m + cfg.block_margin_m
-        if abs(depth_m - self.target_m) < reach and self.overlaps(
+        if (aged or abs(depth_m - self.target_m) < reach) and self.overlaps(
                 lateral_m, reach - cfg.half_width_m):
             return True
         return in_the_way(self.obstacles(depth_m, lateral_m), depth_m, lateral_m, None, 0.0,

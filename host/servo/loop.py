@@ -634,10 +634,16 @@ class Servo:
         if est.state is None or c is None:
             return ""
         fixed = self._fixed_fault(t, cmd)
-        if fixed or abs(est.state.z - c.target_m) >= c.cfg.block_m:
-            return fixed
         s = est.state
-        if not cmd.is_stop and cmd.phase in (Phase.FIND, Phase.SEARCH) and c.sweeps(s.z, s.x):
+        spin = not cmd.is_stop and cmd.phase in (Phase.FIND, Phase.SEARCH)
+        # the object's depth older than target_age_s (no re-measure while spinning): it may
+        # have moved beside the robot unseen, so the spin must clear its extent at any depth
+        aged = self._measured_t is not None and t - self._measured_t > self.cfg.target_age_s
+        if not fixed and spin and aged and c.sweeps(s.z, s.x, aged=True):
+            return TURN_BLOCKED
+        if fixed or abs(s.z - c.target_m) >= c.cfg.block_m:
+            return fixed
+        if spin and c.sweeps(s.z, s.x):
             return TURN_BLOCKED
         # unseen for a few frames (seen, the controller's hold watches the drift itself)
         if t - s.t > 0.1 and c.closing(s.x + s.vx * (t - s.t), s.vx, seen=False):
