@@ -16,10 +16,10 @@ from typing import Protocol
 
 import cv2
 import numpy as np
-from numba import njit
 
 from host.camera.calibration import Calibration, Rectifier
 from host.camera.source import StereoFrame
+from host.sim.hit_box import hit_of
 
 Changed = tuple[np.ndarray, tuple[int, int, int, int] | None]  # Renderer.changed
 
@@ -89,33 +89,6 @@ def _hit(bounds: tuple[np.ndarray, ...], m1: np.ndarray, box: tuple[int, int, in
     rows and columns whose bounds reach there."""
     r0, r1, c0, c1 = box
     row_lo, row_hi, col_lo, col_hi = bounds
-    got = _hit_of(row_lo, row_hi, col_lo, col_hi, m1, r0 - 1, r1 - 1, c0 - 1, c1 - 1)
+    # whole source pixels: x in c0 - 1 .. c1 - 1 is strictly inside (c0 - 2, c1)
+    got = hit_of(row_lo, row_hi, col_lo, col_hi, m1[..., 0], m1[..., 1], c0 - 2, c1, r0 - 2, r1)
     return None if got[0] < 0 else got
-
-
-@njit(cache=True)
-def _hit_of(row_lo: np.ndarray, row_hi: np.ndarray, col_lo: np.ndarray, col_hi: np.ndarray,
-            m1: np.ndarray, y_lo: int, y_hi: int, x_lo: int, x_hi: int
-            ) -> tuple[int, int, int, int]:
-    """_hit's box in one pass over the candidate rows and columns (integer comparisons);
-    y0 = -1: none."""
-    ra, rb, ca, cb = -1, -1, -1, -1
-    for y in range(row_lo.size):
-        if row_hi[y] >= y_lo and row_lo[y] <= y_hi:
-            ra = y if ra < 0 else ra
-            rb = y + 1
-    for x in range(col_lo.size):
-        if col_hi[x] >= x_lo and col_lo[x] <= x_hi:
-            ca = x if ca < 0 else ca
-            cb = x + 1
-    y0, y1, x0, x1 = -1, -1, col_lo.size, -1
-    if ra < 0 or ca < 0:
-        return y0, y1, x0, x1
-    for y in range(ra, rb):
-        for x in range(ca, cb):
-            sx, sy = m1[y, x, 0], m1[y, x, 1]
-            if sx >= x_lo and sx <= x_hi and sy >= y_lo and sy <= y_hi:
-                y0 = y if y0 < 0 else y0
-                y1 = y + 1
-                x0, x1 = min(x0, x), max(x1, x + 1)
-    return y0, y1, x0, x1

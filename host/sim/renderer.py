@@ -31,6 +31,7 @@ from numba import njit
 
 from host.camera.source import StereoFrame
 from host.sim.faults import CameraFaults
+from host.sim.hit_box import hit_of
 from host.sim.world import Person, Robot, World
 from host.stereo.synthetic import Layer, random_texture, render_view
 
@@ -134,36 +135,11 @@ def _lens_hit_box(bounds: LensBounds, mx: np.ndarray, my: np.ndarray,
     row whose source rows reach into (lo_y, hi_y) and a column whose source columns reach
     into (lo_x, hi_x): the pixels are looked for in those rows and columns alone."""
     # the limits as float32, as numpy compares a float32 array with a Python float
-    got = _lens_hit_of(*bounds, mx, my, *(np.float32(v) for v in limits))
+    row_lo, row_hi, col_lo, col_hi = bounds
+    lo_x, hi_x, lo_y, hi_y = (np.float32(v) for v in limits)
+    got = hit_of(row_lo, row_hi, col_lo, col_hi, mx, my, float(lo_x), float(hi_x),
+                 float(lo_y), float(hi_y))
     return None if got[0] < 0 else got
-
-
-@njit(cache=True)
-def _lens_hit_of(row_lo: np.ndarray, row_hi: np.ndarray, col_lo: np.ndarray,
-                 col_hi: np.ndarray, mx: np.ndarray, my: np.ndarray, lo_x: np.float32,
-                 hi_x: np.float32, lo_y: np.float32, hi_y: np.float32
-                 ) -> tuple[int, int, int, int]:
-    """_lens_hit_box's box in one pass over the candidate rows and columns; y0 = -1: none."""
-    ra, rb, ca, cb = -1, -1, -1, -1
-    for y in range(row_lo.size):
-        if row_hi[y] > lo_y and row_lo[y] < hi_y:
-            ra = y if ra < 0 else ra
-            rb = y + 1
-    for x in range(col_lo.size):
-        if col_hi[x] > lo_x and col_lo[x] < hi_x:
-            ca = x if ca < 0 else ca
-            cb = x + 1
-    y0, y1, x0, x1 = -1, -1, col_lo.size, -1
-    if ra < 0 or ca < 0:
-        return y0, y1, x0, x1
-    for y in range(ra, rb):
-        for x in range(ca, cb):
-            sx, sy = mx[y, x], my[y, x]
-            if sx > lo_x and sx < hi_x and sy > lo_y and sy < hi_y:
-                y0 = y if y0 < 0 else y0
-                y1 = y + 1
-                x0, x1 = min(x0, x), max(x1, x + 1)
-    return y0, y1, x0, x1
 
 
 class Renderer:

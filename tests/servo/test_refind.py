@@ -129,6 +129,17 @@ def test_a_drive_does_not_turn_a_turned_card_farther() -> None:
     assert late and all(c.right == c.left for c in late)  # past 30 degrees: straight
 
 
+def _driven_away(servo: Servo, rng: np.random.Generator) -> float:
+    """30 frames whose depth moves away from the target, 2.5 to 2.65 m, the card square and
+    drifting sideways: the time of the last."""
+    t = 0.0
+    for i in range(30):
+        t += 0.033
+        _frame(servo, t, 2.5 + 0.005 * i + float(rng.normal(0, 0.02)), lateral=0.002 * i,
+               aspect=1.0)
+    return t
+
+
 def test_a_heading_that_drove_the_robot_away_is_turned_round_at_the_loss() -> None:
     """Far away a short drive moves the depth less than its noise, and hard steering loses the
     card before the motion check has its ten sightings: over the drives since the heading was
@@ -136,11 +147,7 @@ def test_a_heading_that_drove_the_robot_away_is_turned_round_at_the_loss() -> No
     servo = _servo()
     assert servo.controller is not None
     rng = np.random.default_rng(3)
-    t = 0.0
-    for i in range(30):
-        t += 0.033
-        _frame(servo, t, 2.5 + 0.005 * i + float(rng.normal(0, 0.02)), lateral=0.002 * i,
-               aspect=1.0)
+    t = _driven_away(servo, rng)
     while t < 2.0:
         t += 0.033
         _frame(servo, t, None)
@@ -239,11 +246,7 @@ def test_drives_before_a_re_acquisition_do_not_turn_the_robot_round_after_it() -
     servo = _servo()
     assert servo.controller is not None
     rng = np.random.default_rng(3)
-    t = 0.0
-    for i in range(30):
-        t += 0.033
-        _frame(servo, t, 2.5 + 0.005 * i + float(rng.normal(0, 0.02)), lateral=0.002 * i,
-               aspect=1.0)
+    t = _driven_away(servo, rng)
     servo._reacquire(probe=True, why="the robot's board reset")
     servo.acquisition.phase = Phase.DONE  # its probe showed the heading kept
     for _ in range(3):
