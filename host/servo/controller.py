@@ -112,7 +112,7 @@ class ControlConfig:
     # body, on the facing within slow_spread and the duties' arc, meets a cell within the
     # check's travel at this duty plus the way the measured speed takes to fall (slow_lag_s)
     slow_duty: int = 220
-    slow_spread_deg: float = 20.0
+    slow_spread_deg: float = 15.0
     slow_lag_s: float = 0.6
     check_react_s: float = 0.33  # the servo's check: its reaction and run-down (loop react_s)
     max_speed_mps: float = 0.4  # the robot's speed at full duty (estimator max_speed_mps)
@@ -429,30 +429,28 @@ class Controller:
                     ) -> tuple[float, float]:
         """Near another fixed object's end (_near_end): the duties at most slow_duty, on the
         arc the controller asked for if that one stays clear within the slowed run's travel,
-        else straight, else bent away by a quarter or a half of the duty, then the same at
-        the floor's duty (the first clear of these, or the one that meets a cell farthest on):
-        the servo's check sweeps the arc commanded, and a steer back onto the lane bends it
-        onto the end."""
+        else straight, else bent away by a quarter or a half of the duty (the first clear of
+        these, or the one that meets a cell farthest on): the servo's check sweeps the arc
+        commanded, and a steer back onto the lane bends it onto the end."""
         cfg = self.cfg
         duty = (left + right) / 2
         if duty == 0:
             return left, right
+        k = min(1.0, cfg.slow_duty / abs(duty))
+        d, steer = duty * k, (right - left) / 2 * k
         best: tuple[float, float] | None = None
         far = -1.0
-        for top in (cfg.slow_duty, self.floor):  # none clear at slow_duty: at the floor
-            k = min(1.0, top / abs(duty))
-            d, steer = duty * k, (right - left) / 2 * k
-            for st in (steer, 0.0, abs(d) / 4, -abs(d) / 4, abs(d) / 2, -abs(d) / 2):
-                lo = d - st
-                hi = d + st
-                lift = self.floor - min(abs(lo), abs(hi))
-                if lift > 0:
-                    lo, hi = lo + math.copysign(lift, d), hi + math.copysign(lift, d)
-                hit = self._end_hit(z, x, lo, hi)
-                if hit is None:
-                    return lo, hi
-                if hit > far:
-                    best, far = (lo, hi), hit
+        for st in (steer, 0.0, abs(d) / 4, -abs(d) / 4, abs(d) / 2, -abs(d) / 2):
+            lo = d - st
+            hi = d + st
+            lift = self.floor - min(abs(lo), abs(hi))
+            if lift > 0:
+                lo, hi = lo + math.copysign(lift, d), hi + math.copysign(lift, d)
+            hit = self._end_hit(z, x, lo, hi)
+            if hit is None:
+                return lo, hi
+            if hit > far:
+                best, far = (lo, hi), hit
         assert best is not None
         return best
 
