@@ -48,7 +48,7 @@ from typing import Any
 
 import numpy as np
 
-from host.servo.clearance import in_the_way, own_body
+from host.servo.clearance import Body, in_the_way, own_body, run_fault
 from host.servo.phase import Phase
 
 LINE_BLOCKED = "the robot's line passes through the object"
@@ -105,6 +105,18 @@ class ControlConfig:
     # turn's start to the card's loss (that one over at least half_min_deg; _one_pass)
     half_share: float = 0.6
     half_min_deg: float = 10.0
+    # near another fixed object's end the drive slows to slow_duty, so that the servo's check
+    # (the body swept over the stopping distance at the command's speed) looks only a short
+    # way on and the robot creeps by, re-checked every frame, instead of stopping on a swept
+    # region its heading's spread widens (_near_end; seed 13, box 2's end: issue 23). Near: the
+    # body, on the facing within slow_spread and the duties' arc, meets a cell within the
+    # check's travel at this duty plus the way the measured speed takes to fall (slow_lag_s)
+    slow_duty: int = 220
+    slow_spread_deg: float = 15.0
+    slow_lag_s: float = 0.6
+    check_react_s: float = 0.33  # the servo's check: its reaction and run-down (loop react_s)
+    max_speed_mps: float = 0.4  # the robot's speed at full duty (estimator max_speed_mps)
+    wheelbase_m: float = 0.14  # the wheels' track (loop wheelbase_m)
 
 
 @dataclass(frozen=True)
@@ -406,10 +418,64 @@ class Controller:
             steer += self.trim * duty
         self.phase = Phase.CREEP if creeping else Phase.DRIVE
         left, right = duty - steer, duty + steer
+        if obs.lateral_m is not None and self._near_end(z, obs.lateral_m, left, right):
+            left, right = self._by_the_end(z, obs.lateral_m, left, right)
         lift = self.floor - min(abs(left), abs(right))  # no wheel below the least duty that moves
         if lift > 0:
             left, right = left + math.copysign(lift, duty), right + math.copysign(lift, duty)
         return Command(int(round(left)), int(round(right)), self.phase, e)
+
+    def _by_the_end(self, z: float, x: float, left: float, right: float
+                    ) -> tuple[float, float]:
+        """Near another fixed object's end (_near_end): the duties at most slow_duty, on the
+        arc the controller asked for if that one stays clear within the slowed run's travel,
+        else straight, else bent away by a quarter or a half of the duty (the first clear of
+        these, or the one that meets a cell farthest on): the servo's check sweeps the arc
+        commanded, and a steer back onto the lane bends it onto the end."""
+        cfg = self.cfg
+        duty = (left + right) / 2
+        if duty == 0:
+            return left, right
+        k = min(1.0, cfg.slow_duty / abs(duty))
+        d, steer = duty * k, (right - left) / 2 * k
+        best: tuple[float, float] | None = None
+        far = -1.0
+        for st in (steer, 0.0, abs(d) / 4, -abs(d) / 4, abs(d) / 2, -abs(d) / 2):
+            lo = d - st
+            hi = d + st
+            lift = self.floor - min(abs(lo), abs(hi))
+            if lift > 0:
+                lo, hi = lo + math.copysign(lift, d), hi + math.copysign(lift, d)
+            hit = self._end_hit(z, x, lo, hi)
+            if hit is None:
+                return lo, hi
+            if hit > far:
+                best, far = (lo, hi), hit
+        assert best is not None
+        return best
+
+    def _end_hit(self, z: float, x: float, left: float, right: float) -> float | None:
+        """Where (m on) a run under these duties from (z, x) brings the body (as the servo's
+        check sweeps it: clearance.run_fault, grown by block_margin_m and half a cell) onto
+        another fixed object's cell within the check's travel at this duty and slow_lag_s
+        more, the robot on its facing within slow_spread_deg, or None."""
+        cfg = self.cfg
+        cells = self.obstacles(z, x)
+        if not len(cells) or left + right == 0:
+            return None
+        speed = cfg.max_speed_mps * abs(left + right) / 2000
+        travel = cfg.block_margin_m + speed * (cfg.check_react_s + cfg.slow_lag_s)
+        body = Body(cfg.half_width_m, cfg.half_length_m, cfg.block_margin_m + cfg.cell_m / 2)
+        heading = 0.0 if self.facing_away else math.pi
+        return run_fault(cells, z, x, int(left), int(right), heading,
+                         math.radians(cfg.slow_spread_deg), travel, body, cfg.wheelbase_m)
+
+    def _near_end(self, z: float, x: float, left: float, right: float) -> bool:
+        """Whether the run these duties ask for meets another fixed object's cell within the
+        check's travel and slow_lag_s more (_end_hit): the drive slows and keeps clear
+        (_by_the_end; a heuristic that only lowers the duty and picks the arc: the servo's
+        check still stops any run that would hit)."""
+        return self._end_hit(z, x, left, right) is not None
 
     # --------------------------------------------------------------------------- turn
 
