@@ -86,8 +86,8 @@ def simulation(setup: Setup = Setup(), reference: bool = True) -> Iterator[SimRu
     emulator: Any = Emulator(faults.link) if setup.board is None else setup.board
     source = SimSource(world, emulator, setup.fps, renderer=renderer, events=faults.events,
                        latency_ms=faults.motor.latency_ms, seed=setup.seed)
-    port: Any = setup.board.path if setup.board else LockstepLine(emulator, source.run_ms,
-                                                                   lambda: source.now_ms)
+    port: Any = setup.board.path if setup.board else LockstepLine(
+        emulator, source.run_ms, lambda: source.now_ms, source.run_until_tx)
     reply_timeout_s = max(0.2, setup.reply_timeout_s) if setup.board else setup.reply_timeout_s
     with RobotLink(port, retries=setup.retries, reply_timeout_s=reply_timeout_s,
                    drive_budget_s=max(SERVO_DRIVE_BUDGET_S, 2 * reply_timeout_s),
