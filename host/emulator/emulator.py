@@ -146,7 +146,10 @@ class Emulator:
             self._core.rx(bytes([self._inbound.popleft()[1]]), int(self.now_ms))
 
     def _collect(self) -> None:
-        data = self._core.take_tx()
+        self._queue_tx(self._core.take_tx())
+
+    def _queue_tx(self, data: bytes) -> None:
+        """The core's bytes (just taken from it) onto the line to the host."""
         if not data or self.silent:
             return
         for b in self._faulty(data, TO_HOST):
@@ -185,6 +188,61 @@ class Emulator:
         """Applied duty (permille) of the left and right motor."""
         with self.lock:
             return self._core.motors()
+
+    def has_tx(self) -> bool:
+        """Whether transmit() would return bytes now."""
+        with self.lock:
+            return bool(self._outbound) and self._outbound[0][0] <= self.now_ms
+
+    def lockstep(self) -> Lockstep | None:
+        """The pieces of one millisecond of advance(1), for a caller stepping the world in the
+        same loop (host.sim.source): None when a step needs more than they do (a reset to
+        come, a clock between milliseconds)."""
+        if self.faults.reset_at_ms is not None or self.now_ms != int(self.now_ms):
+            return None
+        return Lockstep(self)
+
+
+class Lockstep:
+    """advance(1) and motors() of an Emulator without a reset to come and on a whole
+    millisecond, taken apart for a loop that calls them every millisecond: the same calls into
+    the core in the same order (the caller holds the emulator's lock)."""
+
+    def __init__(self, emu: Emulator) -> None:
+        core = emu._core
+        lib = core._lib
+        self.guard, self.tick, self.take = lib.robot_guard, lib.robot_tick, lib.emu_take_tx
+        self.read_motors, self.motor_refs = lib.emu_motors, core._motor_refs
+        self.left, self.right, self.buf = core._left, core._right, core._buf
+        self.emu, self.core = emu, core
+
+    def current(self) -> bool:
+        """Whether these are still the emulator's pieces (its core the same, no reset to come,
+        its clock on a whole millisecond)."""
+        emu = self.emu
+        return (emu._core is self.core and emu.faults.reset_at_ms is None
+                and emu.now_ms == int(emu.now_ms))
+
+    def motors(self) -> tuple[int, int]:
+        self.read_motors(*self.motor_refs)
+        return self.left.value, self.right.value
+
+    def advance_1(self) -> None:
+        """advance(1): the clock on a millisecond, the due bytes delivered, the core ticked,
+        its bytes collected."""
+        emu = self.emu
+        emu.now_ms = now = emu.now_ms + 1.0
+        inbound = emu._inbound
+        if inbound and inbound[0][0] <= now:
+            emu._deliver()
+        n = int(now)
+        if n != emu._ticked_ms:
+            emu._ticked_ms = n
+            self.guard(n & 0xFFFFFFFF)
+            self.tick(n & 0xFFFFFFFF)
+        k = self.take(self.buf, len(self.buf))
+        if k:
+            emu._queue_tx(self.buf.raw[:k])
 
 
 class PtyService:

@@ -20,9 +20,13 @@ class LockstepLine:
     name = "the simulated robot's line"
 
     def __init__(self, emulator: Emulator, advance_ms: Callable[[int], None],
-                 now_ms: Callable[[], int]) -> None:
+                 now_ms: Callable[[], int],
+                 advance_until_tx: Callable[[int], None] | None = None) -> None:
+        """advance_until_tx(n): advance_ms(1) up to n times, stopping after the millisecond by
+        which the emulator has a byte for the host (in one call: host.sim.source)."""
         self.emulator = emulator
         self._advance = advance_ms
+        self._advance_until_tx = advance_until_tx
         self._now_ms = now_ms
         self._open = True
 
@@ -37,7 +41,13 @@ class LockstepLine:
     def read(self, wait_s: float) -> bytes:
         emu = self.emulator
         out = emu.transmit()
-        for _ in range(max(1, math.ceil(wait_s * 1000 - 1e-9))):
+        n = max(1, math.ceil(wait_s * 1000 - 1e-9))
+        if self._advance_until_tx is not None:
+            if not out:
+                self._advance_until_tx(n)
+                out = emu.transmit()
+            return out
+        for _ in range(n):
             if out:
                 break
             self._advance(1)

@@ -86,8 +86,8 @@ def simulation(setup: Setup = Setup(), reference: bool = True) -> Iterator[SimRu
     emulator: Any = Emulator(faults.link) if setup.board is None else setup.board
     source = SimSource(world, emulator, setup.fps, renderer=renderer, events=faults.events,
                        latency_ms=faults.motor.latency_ms, seed=setup.seed)
-    port: Any = setup.board.path if setup.board else LockstepLine(emulator, source.run_ms,
-                                                                   lambda: source.now_ms)
+    port: Any = setup.board.path if setup.board else LockstepLine(
+        emulator, source.run_ms, lambda: source.now_ms, source.run_until_tx)
     reply_timeout_s = max(0.2, setup.reply_timeout_s) if setup.board else setup.reply_timeout_s
     with RobotLink(port, retries=setup.retries, reply_timeout_s=reply_timeout_s,
                    drive_budget_s=max(SERVO_DRIVE_BUDGET_S, 2 * reply_timeout_s),
@@ -105,9 +105,29 @@ def simulation(setup: Setup = Setup(), reference: bool = True) -> Iterator[SimRu
         yield run
 
 
+CalibKey = tuple[tuple[int, int], tuple[float, float], int]  # size, lenses, seed
+
+
 @functools.lru_cache(maxsize=32)
+def _calibrate(size: tuple[int, int], distortion: tuple[float, float], seed: int) -> Any:
+    return calibrate_camera(World.for_size(*size), CameraFaults(distortion=distortion), seed)
+
+
+_given: dict[CalibKey, Any] = {}  # calibrations computed elsewhere (keep_calibration)
+
+
 def _calibration(size: tuple[int, int], distortion: tuple[float, float], seed: int) -> Any:
     """The simulated camera's chessboard calibration, which depends on its size, lenses and
-    seed alone: computed once a process for each (trials share a few cameras)."""
-    return calibrate_camera(World.for_size(*size), CameraFaults(distortion=distortion), seed)
+    seed alone: computed once a process for each (trials share a few cameras), unless another
+    process computed it and keep_calibration gave it here (a campaign's workers)."""
+    given = _given.get((size, distortion, seed))
+    return given if given is not None else _calibrate(size, distortion, seed)
+
+
+def keep_calibration(key: CalibKey, calib: Any) -> None:
+    """Use calib, the calibration _calibration(*key) computed in another process (on one
+    thread, as a trial's process does: the same result), instead of computing it here."""
+    if len(_given) >= 32:
+        _given.clear()
+    _given[key] = calib
 

@@ -10,6 +10,7 @@ import numpy as np
 
 from host.camera.source import StereoFrame, StereoSource
 from host.emulator.board import Board
+from host.emulator.emulator import Emulator, Lockstep
 from host.sim.faults import Event
 from host.sim.rectify import Changed
 from host.sim.renderer import Flicker, Renderer
@@ -61,6 +62,7 @@ class SimSource(StereoSource):
         self._held: list[tuple[np.ndarray, float] | None] = [None, None]  # last image, stamp
         self._made: list[tuple[np.ndarray, Changed | None] | None] = [None, None]
         self.log: list[str] = []  # what happened in the scene, with times
+        self._parts: Lockstep | None = None  # the native board's millisecond (_native)
 
     @property
     def t(self) -> float:
@@ -79,6 +81,11 @@ class SimSource(StereoSource):
         are looked at in the milliseconds where one is due (_wake_ms), and the motor outputs
         are queued for their latency only when they change: the same steps as looking every
         millisecond and queueing every output."""
+        parts = self._native()
+        if parts is not None:
+            with parts.emu.lock:
+                self._run_ms_native(ms, parts, until_tx=False)
+            return
         board, step, pending = self.board, self.world.step, self._pending
         latency = int(round(self.latency_ms))
         wake = self._wake_ms()
@@ -96,6 +103,84 @@ class SimSource(StereoSource):
             step(0.001, *self._applied)
             board.advance(1)
             self.now_ms = now + 1
+
+    def run_until_tx(self, ms: int) -> None:
+        """run_ms(1) up to ms times, stopping after the millisecond by which the board has a
+        byte for the host (host.emulator.lockstep's wait for a reply)."""
+        parts = self._native()
+        if parts is not None:
+            with parts.emu.lock:
+                self._run_ms_native(ms, parts, until_tx=True)
+            return
+        board = self.board
+        if not isinstance(board, Emulator):
+            raise TypeError("run_until_tx needs the native core's board (an Emulator)")
+        for _ in range(ms):
+            self.run_ms(1)
+            if board.has_tx():
+                return
+
+    def _native(self) -> Lockstep | None:
+        """The native core's millisecond taken apart (Emulator.lockstep) when the world and
+        the board are the plain ones, else None; kept while the board's core is the same."""
+        board = self.board
+        if type(board) is not Emulator or type(self.world) is not World:
+            return None
+        parts = self._parts
+        if parts is None or not parts.current():
+            parts = self._parts = board.lockstep()
+        return parts
+
+    def _run_ms_native(self, ms: int, parts: Lockstep, until_tx: bool) -> None:
+        """run_ms with the native core's board: the same steps, in one loop (the world's step
+        and the board's advance(1) written out here; World.step and Emulator.advance say what
+        each does)."""
+        pending, w = self._pending, self.world
+        r, m, f = w.robot, w.motors, w.motor_faults
+        latency = int(round(self.latency_ms))
+        wake = self._wake_ms()
+        dt = 0.001
+        a = 1.0 - math.exp(-dt / m.tau_s)
+        wheel, wheelbase, push = w._wheel, m.wheelbase_m, f.push_mps
+        gain, offset = f.gain, f.offset
+        read_motors, advance_1 = parts.motors, parts.advance_1
+        emu = parts.emu
+        outbound = emu._outbound
+        applied, queued = self._applied, self._queued
+        start = self.now_ms
+        for now in range(start, start + ms):
+            if now >= wake:
+                self.now_ms = now
+                self._apply_events()
+                wake = self._wake_ms()
+            motors = read_motors()
+            if motors != queued:
+                pending.append((now + latency, motors))
+                queued = motors
+            while pending and pending[0][0] <= now:
+                applied = pending.popleft()[1]
+            # World.step(dt, *applied)
+            w.t += dt
+            supply = max(0.5, 1.0 - f.sag_per_m * w.travelled_m)
+            duty_left, duty_right = applied
+            traction = w.traction
+            t_left = (wheel(duty_left, supply, gain[0], offset[0], traction[0])
+                      if duty_left else 0.0 * gain[0] * traction[0])
+            t_right = (wheel(duty_right, supply, gain[1], offset[1], traction[1])
+                       if duty_right else 0.0 * gain[1] * traction[1])
+            r.v_left += (t_left - r.v_left) * a
+            r.v_right += (t_right - r.v_right) * a
+            v = (r.v_left + r.v_right) / 2
+            r.theta += (r.v_left - r.v_right) / wheelbase * dt
+            r.x_m += (v * math.sin(r.theta) + push) * dt
+            r.z_m += v * math.cos(r.theta) * dt
+            w.travelled_m += abs(v) * dt
+            advance_1()
+            if until_tx and outbound and outbound[0][0] <= emu.now_ms:
+                ms = now + 1 - start
+                break
+        self.now_ms = start + ms
+        self._applied, self._queued = applied, queued
 
     def _wake_ms(self) -> float:
         """The first millisecond at which _apply_events has something to do: an event due, a
