@@ -949,7 +949,7 @@ class Servo:
         aspect = pair.left.aspect if pair is not None else 1.0
         cmd = self.controller.update(Observation(t, depth, lateral, aspect, invalid))
         if self.controller.fault:  # it cannot go on as it was: back off, or the run ends
-            if self._back_off(t, self.controller.fault):
+            if depth is not None and self._back_off(t, self.controller.fault):
                 return Command(0, 0, Phase.RECOVER, None)
             self.stop_reason = self.stop_reason or self.controller.fault
             return cmd
@@ -959,8 +959,9 @@ class Servo:
     def _back_off(self, t: float, fault: str) -> bool:
         """The body near the object's side (the controller's PUSHED or LINE_BLOCKED): a
         wait (kind "beside", recovery.py) in which the target is measured again and the robot
-        backs off out of the object's depth (recovery.BackOff); False when the run ends
-        (no recovery, or the third time in this run: stop_reason set)."""
+        backs off out of the object's depth (recovery.BackOff), the card seen this frame
+        (unseen, the push's drift is a guess and the run ends as before); False when the
+        run ends (no recovery, or the fourth time in this run: stop_reason set)."""
         if not self.cfg.recover or fault not in (PUSHED, LINE_BLOCKED) or \
                 self.estimator.state is None or not self._recover(t, BESIDE, fault):
             return False

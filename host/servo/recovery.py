@@ -160,6 +160,8 @@ class BackOffConfig:
     camera_m: float = 0.6  # nor nearer the camera than this
     turn_m: float = 0.01  # the gap to the object's side shrinking this much backing off: the
     # robot is turned toward it, and backs off the other way
+    turned: float = 0.3  # ... and by this much a metre of depth travelled (a heading ~17
+    # degrees toward it; a 1 cm/s push at the back-off's ~8 cm/s is 0.12)
     unseen_s: float = 1.0  # the card unseen this long backing off (turned away): re-acquired
 
 
@@ -174,12 +176,14 @@ class BackOff:
     straight along its line, away from the object's depth (toward the camera unless the
     robot is beyond the object's face), to block_m + clear_m from it; the servo re-acquires
     and the controller plans its lane anew, clear of the object. A robot turned toward the
-    object's side closes on it backing off: its gap shrinking by turn_m, it backs off the
-    other way instead (once; the body's far corner is then on the object's open side). A
-    pure state machine, one call a frame: update gives the wheels' duties; `outcome` is
-    DONE (resume) or why there is no safe way back (the run ends, named), "" while under
-    way. The loop's checks of a drive (the marker in view, the fixed objects, the motion
-    against the command) act on the back-off's commands as on any drive."""
+    object's side closes on it backing off: its gap shrinking by turn_m, and by turned a
+    metre of depth travelled, it backs off the other way instead (once; the body's far
+    corner is then on the object's open side). A pure state machine, one call a frame:
+    update gives the wheels' duties; `outcome` is DONE (resume) or why there is no safe way
+    back (the run ends, named), "" while under way. The loop's checks of a drive (the
+    marker in view, the fixed objects, the motion against the command) act on the
+    back-off's commands as on any drive; the lane watch does not (it looks toward the
+    target, and the back-off goes the other way, within max_m)."""
 
     def __init__(self, block_m: float, cfg: BackOffConfig = BackOffConfig()) -> None:
         self.block_m, self.cfg = block_m, cfg
@@ -213,8 +217,10 @@ class BackOff:
             self.outcome = DONE  # out of the object's depth (measured again: never in it)
             return 0, 0
         assert self.start_z is not None
-        closing = gap is not None and self.start_gap is not None and \
-            gap < self.start_gap - cfg.turn_m
+        # closing on the side as it goes: turned toward it (a push alone closes far less
+        # per metre of depth travelled)
+        shrunk = 0.0 if gap is None or self.start_gap is None else self.start_gap - gap
+        closing = shrunk > max(cfg.turn_m, cfg.turned * abs(z - self.start_z))
         if gap is not None and gap < 0:
             self.outcome = "no safe way back: the body is across the object's side"
         elif closing and self.flipped:
