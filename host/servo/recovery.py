@@ -162,6 +162,7 @@ class BackOffConfig:
     # robot is turned toward it, and backs off the other way
     turned: float = 0.3  # ... and by this much a metre of depth travelled (a heading ~17
     # degrees toward it; a 1 cm/s push at the back-off's ~8 cm/s is 0.12)
+    side_m: float = 0.01  # the body this near the object's side (or across it): it stands
     unseen_s: float = 1.0  # the card unseen this long backing off (turned away): re-acquired
 
 
@@ -199,8 +200,8 @@ class BackOff:
         """z: the robot's depth this frame at t (None: not seen, it stands; unseen unseen_s
         once it has moved, the back-off ends: the re-acquisition looks for the card, its
         spin checked as any); gap: the body's clearance across from the object's extent
-        (m, < 0 across it; None: not known); target_m the object's depth, confirmed when
-        measured again since the back-off began."""
+        (m, < 0 across it; None: not known; within side_m, no safe way back); target_m
+        the object's depth, confirmed when measured again since the back-off began."""
         if z is not None:
             self.seen_t = t
         elif self.start_z is not None and self.seen_t is not None and \
@@ -221,8 +222,8 @@ class BackOff:
         # per metre of depth travelled)
         shrunk = 0.0 if gap is None or self.start_gap is None else self.start_gap - gap
         closing = shrunk > max(cfg.turn_m, cfg.turned * abs(z - self.start_z))
-        if gap is not None and gap < 0:
-            self.outcome = "no safe way back: the body is across the object's side"
+        if gap is not None and gap < cfg.side_m:
+            self.outcome = "no safe way back: the body is at the object's side"
         elif closing and self.flipped:
             self.outcome = "no safe way back: backing off either way closes on its side"
         elif abs(z - self.start_z) > cfg.max_m:
