@@ -10,7 +10,12 @@ from __future__ import annotations
 
 import math
 
+import pytest
+
 from host.servo.recovery import DONE, BackOff, BackOffConfig
+from host.sim.faults import MotorFaults, WorldFaults
+from host.sim.run import Setup, simulation
+from host.sim.trials import _unsafe
 
 BOX = (-0.50, -0.18)  # the object's lateral extent (m): the default scene's nearest box
 HALF_WIDTH = 0.08
@@ -92,3 +97,30 @@ def test_no_safe_way_back_ends_the_run_named() -> None:
     b, _, _, least, _ = _back_off(1.2, -0.05, math.radians(30), 1.2, push=-0.1)
     assert b.outcome.startswith("no safe way back")
     assert least > 0.0  # it stood before its body reached the side
+
+
+@pytest.mark.slow  # a closed-loop run (the slow tier's, as test_fixed_objects')
+def test_in_closed_loop_a_robot_pushed_while_it_holds_backs_off_and_holds_again() -> None:
+    """The simulated world: the robot holds beside the object 4 cm left of centre (its body
+    6 cm from the object's side) while a slope pushes it toward the object at 8 mm/s. It
+    backed off and planned its lane anew rather than ending the run ("pushed sideways onto
+    the object while holding", as it did before the back-off), and holds again, its body
+    never touching the object (the trials' judge)."""
+    faults = WorldFaults(motor=MotorFaults(push_mps=-0.008))
+    with simulation(Setup(start_z_m=1.25, start_x_m=-0.04, faults=faults, seed=3)) as sim:
+        servo, last_valid, outcome = sim.servo, sim.source.t, "unsettled"
+        while sim.source.t < 30.0:
+            sim.step()
+            row = servo.rows[-1]
+            if math.isfinite(row.depth_m) and not row.reason:
+                last_valid = row.t
+            why = _unsafe(sim, last_valid, servo.stale_s)
+            assert not why, why
+            if servo.stop_reason:
+                outcome = servo.stop_reason
+                break
+            if servo.held_for(1.0) and sim.source.t > 8.0:
+                outcome = "held"
+                break
+        assert outcome == "held"
+        assert any("backed off" in note for note in servo.notes)
