@@ -162,7 +162,9 @@ class BackOffConfig:
     # robot is turned toward it, and backs off the other way
     turned: float = 0.3  # ... and by this much a metre of depth travelled (a heading ~17
     # degrees toward it; a 1 cm/s push at the back-off's ~8 cm/s is 0.12)
-    side_m: float = 0.01  # the body this near the object's side (or across it): it stands
+    side_m: float = 0.01  # the body this near the object's side (or across it): it backs
+    # off only away from the face, and stands if that closes on the side level with the face
+    level_m: float = 0.12  # level with the face: the body's half diagonal (0.113) reaches it
     unseen_s: float = 1.0  # the card unseen this long backing off (turned away): re-acquired
 
 
@@ -222,17 +224,24 @@ class BackOff:
         # per metre of depth travelled)
         shrunk = 0.0 if gap is None or self.start_gap is None else self.start_gap - gap
         closing = shrunk > max(cfg.turn_m, cfg.turned * abs(z - self.start_z))
-        if gap is not None and gap < cfg.side_m:
+        # level with the object's face (within level_m of its depth) the body's side can
+        # reach the object's; off it, across the object's extent is only its line, and the
+        # way away from the face is the one way back (the other way is into the face)
+        level = abs(e) < cfg.level_m
+        tight = gap is not None and gap < cfg.side_m
+        if level and closing and (self.flipped or tight):
+            self.outcome = ("no safe way back: backing off either way closes on its side"
+                            if self.flipped else
+                            "no safe way back: backing off closes on the object's side")
+        elif level and gap is not None and gap < 0 <= (self.start_gap or 0.0):
             self.outcome = "no safe way back: the body is at the object's side"
-        elif closing and self.flipped:
-            self.outcome = "no safe way back: backing off either way closes on its side"
         elif abs(z - self.start_z) > cfg.max_m:
             self.outcome = f"no safe way back: {cfg.max_m:.2f} m backed off and still beside it"
         elif not self.deeper and z < cfg.camera_m:
             self.outcome = "no safe way back: the camera is behind the robot"
         if self.outcome:
             return 0, 0
-        if closing:  # turned toward the object's side: the other way along its line
+        if closing and not tight:  # turned toward the object's side: the other way
             self.deeper, self.flipped, self.start_z, self.start_gap = \
                 not self.deeper, True, z, gap
         sign = 1 if self.deeper == facing_away else -1

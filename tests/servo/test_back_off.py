@@ -89,14 +89,24 @@ def test_a_robot_turned_toward_the_side_backs_off_the_other_way() -> None:
 
 
 def test_no_safe_way_back_ends_the_run_named() -> None:
-    """A body already across the object's side, or one that closes on it either way (turned
-    toward it and pushed at 10 cm/s), has no safe way back: the outcome says so, and it
-    stands before its body reaches the side."""
-    b, _, _, _, cmds = _back_off(1.2, -0.15, 0.0, 1.2)
-    assert b.outcome.startswith("no safe way back") and cmds == [(0, 0)]
+    """A body that closes on the object's side either way (turned toward it and pushed at
+    10 cm/s) has no safe way back: the outcome says so, and it stands before its body
+    reaches the side."""
     b, _, _, least, _ = _back_off(1.2, -0.05, math.radians(30), 1.2, push=-0.1)
     assert b.outcome.startswith("no safe way back")
     assert least > 0.0  # it stood before its body reached the side
+
+
+def test_a_line_through_the_object_backs_off_only_away_from_its_face() -> None:
+    """Its line through the object (the body across the object's extent, 10 cm in front of
+    its face: "the robot's line passes through the object") and turned 20 degrees so that
+    backing off takes it farther across: the way away from the face is the one way back (the
+    other way is into the face), so it does not turn to it; it backs off to block_m +
+    clear_m from the face."""
+    b, z, _, _, cmds = _back_off(1.1, -0.15, math.radians(20), 1.2)
+    assert b.outcome == DONE and not b.flipped
+    assert z <= 1.2 - BLOCK - BackOffConfig().clear_m
+    assert all(left < 0 and right < 0 for left, right in cmds if left or right)
 
 
 @pytest.mark.slow  # a closed-loop run (the slow tier's, as test_fixed_objects')
