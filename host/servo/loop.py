@@ -120,6 +120,10 @@ AGAINST_REASON = "the depth moves against the commanded direction"
 STILL_REASON = "the marker did not move while the robot drove"
 MAX_FLIPS = 2  # heading corrections in a run before "against" ends it
 REREFERENCE_TRIES = 3  # re-references (of reference_frames each) before a moved camera stops
+BACK_OFF_S = 15.0  # a back-off (recovery.BackOff) needs this long before the run's deadline:
+# its ~0.3 m at ~8 cm/s, the re-acquisition (a measure, maybe a turn), the approach and a
+# hold; later the stop stands as named (seed 13 trial 175 backed off at 32 s of 45 and
+# was still looking for its card at the limit: "did not settle")
 LATE_S = 0.5  # a wait still on this near the run's deadline ends the run, named (a few frames
 # before the run driver's own check)
 
@@ -960,9 +964,11 @@ class Servo:
         """The body near the object's side (the controller's PUSHED or LINE_BLOCKED): a
         wait (kind "beside", recovery.py) in which the target is measured again and the robot
         backs off out of the object's depth (recovery.BackOff), the card seen this frame
-        (unseen, the push's drift is a guess and the run ends as before); False when the
-        run ends (no recovery, or the fourth time in this run: stop_reason set)."""
-        if not self.cfg.recover or fault not in (PUSHED, LINE_BLOCKED) or \
+        (unseen, the push's drift is a guess and the run ends as before), BACK_OFF_S or
+        more before the run's deadline; False when the run ends (no recovery, too late, or
+        the fourth time in this run: stop_reason set)."""
+        late = self.deadline is not None and self.clock() > self.deadline - BACK_OFF_S
+        if not self.cfg.recover or fault not in (PUSHED, LINE_BLOCKED) or late or \
                 self.estimator.state is None or not self._recover(t, BESIDE, fault):
             return False
         assert self.tracker is not None and self.controller is not None
