@@ -51,6 +51,7 @@ from host.servo.controller import (
     DRIFTED,
     INTO_FIXED,
     LINE_BLOCKED,
+    PUSHED,
     TURN_BLOCKED,
     Command,
     ControlConfig,
@@ -83,7 +84,21 @@ from host.servo.perception import (
 )
 from host.servo.phase import Phase
 from host.servo.progress import Progress, ProgressConfig
-from host.servo.recovery import LANE, LOST, MOVED, RESET, RESUME, TARGET, Recovery, servo_bounds
+from host.servo.recovery import (
+    BESIDE,
+    DONE,
+    GIVE_UP,
+    LANE,
+    LOST,
+    MOVED,
+    RESET,
+    RESUME,
+    TARGET,
+    BackOff,
+    BackOffConfig,
+    Recovery,
+    servo_bounds,
+)
 from host.servo.recovery import OUTSIDE as OUTSIDE_KIND
 from host.servo.refind import FOUND, WHOLE, LostCard, Refind, RefindConfig
 from host.servo.rereference import (
@@ -105,6 +120,10 @@ AGAINST_REASON = "the depth moves against the commanded direction"
 STILL_REASON = "the marker did not move while the robot drove"
 MAX_FLIPS = 2  # heading corrections in a run before "against" ends it
 REREFERENCE_TRIES = 3  # re-references (of reference_frames each) before a moved camera stops
+BACK_OFF_S = 15.0  # a back-off (recovery.BackOff) needs this long before the run's deadline:
+# its ~0.3 m at ~8 cm/s, the re-acquisition (a measure, maybe a turn), the approach and a
+# hold; later the stop stands as named (seed 13 trial 175 backed off at 32 s of 45 and
+# was still looking for its card at the limit: "did not settle")
 LATE_S = 0.5  # a wait still on this near the run's deadline ends the run, named (a few frames
 # before the run driver's own check)
 
@@ -178,6 +197,7 @@ class ServoConfig:
     tracker: TrackerConfig = field(default_factory=TrackerConfig)
     progress: ProgressConfig = field(default_factory=ProgressConfig)
     refind: RefindConfig = field(default_factory=RefindConfig)
+    back_off: BackOffConfig = field(default_factory=BackOffConfig)  # recovery.BackOff
 
 
 @dataclass
@@ -277,6 +297,7 @@ class Servo:
         self.progress = Progress(self.cfg.progress)  # no progress for long: the run ends
         self.refind: Refind | None = None  # the card lost while driving, looked for (refind.py)
         self.lost_card = LostCard(self.cfg.refind)  # the refind's bookkeeping (refind.py)
+        self.backoff: BackOff | None = None  # backing off the object's side (recovery.py)
         self.deadline: float | None = None  # on clock(): the run driver ends the run then
         # (servo_run.Rules.limit_s); a wait still on just before it ends it, named (_too_late)
 
@@ -927,13 +948,62 @@ class Servo:
         if self._must_stop():  # the motion check may have ended the run
             return Command(0, 0, Phase.STOP, None)
         depth, lateral = position if position is not None else (None, None)
+        if self.backoff is not None:
+            return self._backing_off(t, depth, lateral)
         aspect = pair.left.aspect if pair is not None else 1.0
         cmd = self.controller.update(Observation(t, depth, lateral, aspect, invalid))
-        if self.controller.fault:  # it cannot go on: the run ends here
-            self.stop_reason = self.controller.fault
+        if self.controller.fault:  # it cannot go on as it was: back off, or the run ends
+            if depth is not None and self._back_off(t, self.controller.fault):
+                return Command(0, 0, Phase.RECOVER, None)
+            self.stop_reason = self.stop_reason or self.controller.fault
             return cmd
         return self._refind_step(t, None if position is None else aspect,
                                  None if position is None else position[0], cmd)
+
+    def _back_off(self, t: float, fault: str) -> bool:
+        """The body near the object's side (the controller's PUSHED or LINE_BLOCKED): a
+        wait (kind "beside", recovery.py) in which the target is measured again and the robot
+        backs off out of the object's depth (recovery.BackOff), the card seen this frame
+        (unseen, the push's drift is a guess and the run ends as before), BACK_OFF_S or
+        more before the run's deadline; False when the run ends (no recovery, too late, or
+        the fourth time in this run: stop_reason set)."""
+        late = self.deadline is not None and self.clock() > self.deadline - BACK_OFF_S
+        if not self.cfg.recover or fault not in (PUSHED, LINE_BLOCKED) or late or \
+                self.estimator.state is None or not self._recover(t, BESIDE, fault):
+            return False
+        assert self.tracker is not None and self.controller is not None
+        self.tracker.aged()  # measured again (confirmed or replaced) before it moves
+        self.backoff = BackOff(self.controller.cfg.block_m, self.cfg.back_off)
+        return True
+
+    def _backing_off(self, t: float, depth: float | None, lateral: float | None) -> Command:
+        """A frame of the back-off (_back_off): its command; done, the robot re-acquired with
+        its heading and estimate kept (the controller anew plans its lane clear of the
+        object); no safe way back, or the wait's bound spent, the run ends named."""
+        b, c, rec = self.backoff, self.controller, self.recovery
+        assert b is not None and c is not None
+        if rec.kind != BESIDE:  # another wait took over (a reset, a moved camera): its own
+            self.backoff = None  # way back re-acquires the robot
+            return Command(0, 0, Phase.RECOVER, None)
+        gap = None
+        if lateral is not None and c.keep_out is not None:
+            x0, x1 = c.keep_out  # the body's clearance across from the object's extent
+            gap = max(lateral - x1, x0 - lateral) - c.cfg.half_width_m
+        left, right = b.update(t, depth, gap, c.target_m, self.tracker_confirmed, c.facing_away,
+                               c.trim)
+        if b.outcome == DONE:
+            rec.update(t, True)
+            self.backoff = None
+            self._reacquire(probe=False, why=f"{c.fault}: backed off", keep_estimate=True)
+            return Command(0, 0, Phase.RECOVER, None)
+        if b.outcome:
+            rec.give_up(b.outcome)
+        elif rec.update(t, False) != GIVE_UP:
+            moving = left or right
+            return Command(left, right, Phase.DRIVE if moving else Phase.RECOVER, None)
+        self.backoff = None
+        self.stop_reason = self.stop_reason or rec.fault
+        return Command(0, 0, Phase.STOP, None)
 
     def _refind_step(self, t: float, aspect: float | None, depth: float | None,
                      cmd: Command) -> Command:
@@ -1199,7 +1269,8 @@ class Servo:
             self.stop_reason = self.stop_reason or fault
             self.controller.phase = Phase.STOP
             return Command(0, 0, Phase.STOP, cmd.error_m), invalid
-        blocked = self._lane_blocked(frame, cmd) if moving else ""
+        # backing off (away from the target's depth) the lane ahead is not the way it goes
+        blocked = self._lane_blocked(frame, cmd) if moving and self.backoff is None else ""
         rec = self.recovery
         if blocked:
             if rec.kind == LANE:

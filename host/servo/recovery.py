@@ -19,6 +19,12 @@ a safe stop: the same reason the servo stopped with before it could recover.
                the acquisition's whole-view search
     target     a nearer object that replaced the target went away, the target found
                again where it was, in both views          -        3
+    beside     the robot's body near the object's side   10       3
+               (pushed while holding, or its line through
+               the object): the target measured again, the
+               robot backed off along its line out of the
+               object's depth (BackOff), re-acquired; the
+               lane is planned anew clear of the object
 
 The bounds, on reasoning rather than on any seed: a re-reference takes five frames and its
 checks a few more, so 10 s is many tries; a board that resets comes back within a second
@@ -28,7 +34,9 @@ stay 2-6 s), a box left for 20 s is not coming back soon; a sensor that delivers
 for 10 s is broken; a marker that keeps leaving the gate after two re-acquisitions is not one
 the servo can trust; the spin back after a card lost while driving takes at most 2 s (3 s
 standing when nothing turned it away), and a robot that loses its card a sixth time in a run
-steers in a way the servo does not follow.
+steers in a way the servo does not follow. A robot pushed onto the object's side three times
+in a run (the backing off and the lane anew take a few seconds each) is on a slope the hold
+cannot stand on.
 """
 
 from __future__ import annotations
@@ -36,8 +44,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-MOVED, RESET, LANE, STALE, OUTSIDE, TARGET, LOST = "moved", "reset", "lane", "stale", \
-    "outside", "target", "lost"
+MOVED, RESET, LANE, STALE, OUTSIDE, TARGET, LOST, BESIDE = "moved", "reset", "lane", \
+    "stale", "outside", "target", "lost", "beside"
 WAIT, RESUME, GIVE_UP = "wait", "resume", "give up"
 
 
@@ -56,6 +64,7 @@ BOUNDS: dict[str, Bound] = {
     OUTSIDE: Bound(10.0, 0.0, 2),
     TARGET: Bound(0.0, 0.0, 3),
     LOST: Bound(5.0, 0.0, 5),
+    BESIDE: Bound(10.0, 0.0, 3),
 }
 
 
@@ -140,6 +149,104 @@ class Recovery:
         """The recovery itself failed (why): the run ends."""
         self.fault = f"{self.reason}: {why}" if self.reason else why
         self.kind = ""
+
+
+@dataclass(frozen=True)
+class BackOffConfig:
+    duty: int = 350  # permille, straight along the robot's line (the wheels' trim kept)
+    clear_m: float = 0.10  # backed off to this far beyond block_m of the object's depth: the
+    # run-up in which the new lane's steering moves the body sideways
+    max_m: float = 0.40  # depth travelled backing off without clearing it: no way back
+    camera_m: float = 0.6  # nor nearer the camera than this
+    turn_m: float = 0.01  # the gap to the object's side shrinking this much backing off: the
+    # robot is turned toward it, and backs off the other way
+    turned: float = 0.3  # ... and by this much a metre of depth travelled (a heading ~17
+    # degrees toward it; a 1 cm/s push at the back-off's ~8 cm/s is 0.12)
+    side_m: float = 0.01  # the body this near the object's side (or across it): it backs
+    # off only away from the face, and stands if that closes on the side level with the face
+    level_m: float = 0.12  # level with the face: the body's half diagonal (0.113) reaches it
+    unseen_s: float = 1.0  # the card unseen this long backing off (turned away): re-acquired
+
+
+DONE = "done"
+
+
+class BackOff:
+    """The robot's body came near the object's side (controller: pushed while holding, or
+    its line passes through the object): rather than end the run, the robot stands while the
+    target is measured again (its depth may have moved: a stale depth puts the object beside
+    the robot when it is not), then, still within block_m of the fresh depth, backs off
+    straight along its line, away from the object's depth (toward the camera unless the
+    robot is beyond the object's face), to block_m + clear_m from it; the servo re-acquires
+    and the controller plans its lane anew, clear of the object. A robot turned toward the
+    object's side closes on it backing off: its gap shrinking by turn_m, and by turned a
+    metre of depth travelled, it backs off the other way instead (once; the body's far
+    corner is then on the object's open side). A pure state machine, one call a frame:
+    update gives the wheels' duties; `outcome` is DONE (resume) or why there is no safe way
+    back (the run ends, named), "" while under way. The loop's checks of a drive (the
+    marker in view, the fixed objects, the motion against the command) act on the
+    back-off's commands as on any drive; the lane watch does not (it looks toward the
+    target, and the back-off goes the other way, within max_m)."""
+
+    def __init__(self, block_m: float, cfg: BackOffConfig = BackOffConfig()) -> None:
+        self.block_m, self.cfg = block_m, cfg
+        self.outcome = ""
+        self.deeper: bool | None = None  # the way it backs off, fixed once measured
+        self.start_z: float | None = None
+        self.start_gap: float | None = None  # the body's gap to the object's side then
+        self.flipped = False
+        self.seen_t: float | None = None  # the card last seen
+
+    def update(self, t: float, z: float | None, gap: float | None, target_m: float,
+               confirmed: bool, facing_away: bool, trim: float) -> tuple[int, int]:
+        """z: the robot's depth this frame at t (None: not seen, it stands; unseen unseen_s
+        once it has moved, the back-off ends: the re-acquisition looks for the card, its
+        spin checked as any); gap: the body's clearance across from the object's extent
+        (m, < 0 across it; None: not known; within side_m, no safe way back); target_m
+        the object's depth, confirmed when measured again since the back-off began."""
+        if z is not None:
+            self.seen_t = t
+        elif self.start_z is not None and self.seen_t is not None and \
+                t - self.seen_t > self.cfg.unseen_s and not self.outcome:
+            self.outcome = DONE
+        if self.outcome or z is None or not confirmed:
+            return 0, 0
+        e = z - target_m
+        cfg = self.cfg
+        first = self.start_z is None
+        if first:
+            self.deeper, self.start_z, self.start_gap = e > 0.02, z, gap
+        if abs(e) >= self.block_m + (0.0 if first else cfg.clear_m):
+            self.outcome = DONE  # out of the object's depth (measured again: never in it)
+            return 0, 0
+        assert self.start_z is not None
+        # closing on the side as it goes: turned toward it (a push alone closes far less
+        # per metre of depth travelled)
+        shrunk = 0.0 if gap is None or self.start_gap is None else self.start_gap - gap
+        closing = shrunk > max(cfg.turn_m, cfg.turned * abs(z - self.start_z))
+        # level with the object's face (within level_m of its depth) the body's side can
+        # reach the object's; off it, across the object's extent is only its line, and the
+        # way away from the face is the one way back (the other way is into the face)
+        level = abs(e) < cfg.level_m
+        tight = gap is not None and gap < cfg.side_m
+        if level and closing and (self.flipped or tight):
+            self.outcome = ("no safe way back: backing off either way closes on its side"
+                            if self.flipped else
+                            "no safe way back: backing off closes on the object's side")
+        elif level and gap is not None and gap < 0 <= (self.start_gap or 0.0):
+            self.outcome = "no safe way back: the body is at the object's side"
+        elif abs(z - self.start_z) > cfg.max_m:
+            self.outcome = f"no safe way back: {cfg.max_m:.2f} m backed off and still beside it"
+        elif not self.deeper and z < cfg.camera_m:
+            self.outcome = "no safe way back: the camera is behind the robot"
+        if self.outcome:
+            return 0, 0
+        if closing and not tight:  # turned toward the object's side: the other way
+            self.deeper, self.flipped, self.start_z, self.start_gap = \
+                not self.deeper, True, z, gap
+        sign = 1 if self.deeper == facing_away else -1
+        d = sign * cfg.duty
+        return int(round(d * (1 - trim))), int(round(d * (1 + trim)))
 
 
 def _nth(n: int) -> str:
