@@ -54,7 +54,7 @@ def run(events: tuple[Event, ...], start_z: float = 0.6, seconds: float = 25.0,
         # with nothing new in the world, a stop on an object in the line is a phantom's
         nothing_new = sim.world.boxes == boxes and not sim.world.decoys
         claims = OBJECT_CLAIMS if nothing_new else ()
-        if out.kind == "stopped" and (out.reason in claims or (
+        if out.kind == "stopped" and (out.reason.startswith(claims) or (
                 out.reason == "target vanished" and boxes[0] in sim.world.boxes)):
             out.kind = "false reason"
         return out
