@@ -114,14 +114,7 @@ class TargetTracker:
             return old
         if vouched is None:
             return old  # hidden, a nearer object not yet vouched for, or nothing clear
-        found = vouched
-        self._doubt = (0, "")
-        self.nearer.reset()
-        self.target = found
-        self.history = [found.disparity] * (self.cfg.history - 1)
-        self.retargeted = self.measured = True
-        self.fresh = None
-        return found
+        return self._retarget(vouched)
 
     def update_found(self, found: Target) -> Target:
         """The target found again (moved or not): its disparity the median of the last
@@ -193,14 +186,19 @@ class TargetTracker:
                 self.stop_reason = VANISHED
             return self.target
         self.gone = 0
+        self.successor.reset()
+        return self._retarget(vouched)
+
+    def _retarget(self, new: Target) -> Target:
+        """new becomes the target: no doubt left, the nearer-object check started again, its
+        history its own disparity alone, measured now (not aged)."""
         self._doubt = (0, "")
         self.nearer.reset()
-        self.successor.reset()
-        self.target = vouched
-        self.history = [vouched.disparity] * (self.cfg.history - 1)
+        self.target = new
+        self.history = [new.disparity] * (self.cfg.history - 1)
         self.retargeted = self.measured = True
         self.fresh = None
-        return vouched
+        return new
 
 
 def with_target(reference: np.ndarray, target: Target, extent_m: tuple[float, float],

@@ -134,6 +134,16 @@ def freeze(file: Any, configs: Sequence[Any],
     return 0
 
 
+def assert_frozen(file: Any, configs: Sequence[Any],
+                  run: Callable[[Any], tuple[np.ndarray, np.ndarray]], i: int) -> None:
+    """Configuration i's left and right maps equal those freeze wrote into file (NaN where
+    the reference has no disparity): freeze's check, for each reference module's test."""
+    stored = np.load(file)
+    left, right = run(configs[i])
+    np.testing.assert_array_equal(left, unpack(stored[f"left{i}"]))
+    np.testing.assert_array_equal(right, unpack(stored[f"right{i}"]))
+
+
 def main() -> int:
     return freeze(FILE, CONFIGS, run, pack)
 

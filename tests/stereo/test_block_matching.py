@@ -67,10 +67,7 @@ def test_sad_maps_equal_the_reference_written_before_the_speed_rework(i: int) ->
     # sad_reference.npz holds sad.match_sad's maps at commit 85cf046 for every configuration
     # (candidate counts 16..128, grey and colour, uint16 and int32 lanes, both borders, fits,
     # uniqueness, LR's right map, one band or three)
-    stored = np.load(sad_reference.FILE)
-    left, right = sad_reference.run(sad_reference.CONFIGS[i])
-    np.testing.assert_array_equal(left, sgm_reference.unpack(stored[f"left{i}"]))
-    np.testing.assert_array_equal(right, sgm_reference.unpack(stored[f"right{i}"]))
+    sgm_reference.assert_frozen(sad_reference.FILE, sad_reference.CONFIGS, sad_reference.run, i)
 
 
 def test_border_invalid_never_uses_pixels_outside_the_image() -> None:

@@ -273,10 +273,7 @@ def test_sgm_beats_opencv_sgbm_3way_on_middlebury(middlebury: Path, name: str) -
 def test_sgm_maps_equal_the_reference_written_before_the_speed_rework(i: int) -> None:
     # sgm_reference.npz holds sgm.match's maps at commit 711cc8e for every configuration
     # (candidate counts 16..100, 4/5/8 paths, cost volume or census rows, uniqueness, fits)
-    stored = np.load(sgm_reference.FILE)
-    left, right = sgm_reference.run(sgm_reference.CONFIGS[i])
-    np.testing.assert_array_equal(left, sgm_reference.unpack(stored[f"left{i}"]))
-    np.testing.assert_array_equal(right, sgm_reference.unpack(stored[f"right{i}"]))
+    sgm_reference.assert_frozen(sgm_reference.FILE, sgm_reference.CONFIGS, sgm_reference.run, i)
 
 
 CENSUS_ROWS = [i for i, c in enumerate(sgm_reference.CONFIGS) if c[3] == 0]
