@@ -252,8 +252,9 @@ def subpixel(mb: Path) -> None:
         region = s.masks["nonocc"]
         for label, base in setups:
             for fit in ("none", "parabola", "equiangular"):
+                # own SGM's defaults leave the fit off (subpixel False): a fit's row turns it on
                 p = base.replace(subpixel=False) if fit == "none" else base.replace(
-                    subpixel_fit=fit)
+                    subpixel=True, subpixel_fit=fit)
                 d = compute_disparity(s.left, s.right, p)
                 half = evaluate(d, s.gt, region, rho=0.5)
                 one = evaluate(d, s.gt, region, rho=1.0)
