@@ -224,19 +224,6 @@ def test_sgm_is_indifferent_to_an_exposure_change() -> None:
     assert ((sa == sb) | (np.isnan(sa) & np.isnan(sb))).mean() < same.mean()
 
 
-def test_sgm_lr_check_removes_occluded_pixels() -> None:
-    scene = synthetic_scene(seed=3, noise=0.5)
-    base = SGM.replace(num_disparities=48)
-    plain = compute_disparity(scene.left, scene.right, base)
-    checked = compute_disparity(scene.left, scene.right, base.replace(lr_check=1.0))
-    occluded = scene.masks["all"] & ~scene.masks["nonocc"]
-    assert occluded.sum() > 200
-    assert np.isfinite(plain[occluded]).mean() > 0.95
-    assert np.isnan(checked[occluded]).mean() > 0.6
-    visible = scene.masks["nonocc"]
-    assert np.isfinite(checked[visible]).mean() > 0.9
-
-
 def test_sgm_path_count_other_than_4_5_or_8_is_refused() -> None:
     with pytest.raises(HostError, match="paths must be 4, 5 or 8"):
         SGM.replace(paths=6).validate()
