@@ -15,10 +15,10 @@ way the robot faces by what a short probe move does (a pure state machine, one c
              the run stops with that reason (NOT_MOVED: the loop looks for another marker),
              but a move under probe_m within the noise (three of a sighting's noise beyond
              still_factor probe_m, far away) shows no such thing: the second leg, and
-             NOT_MOVED only if its own move is under probe_m too; moved within the noise by probe_s (far away):
-             the second leg, back the other way through the start and as far beyond it
-             (each of the first's duties held back_factor times as long), decides on its
-             own move beyond the noise,
+             NOT_MOVED only if its own move is under probe_m too; moved within the noise
+             by probe_s (far away): the second leg, back the other way through the start
+             and as far beyond it (each of the first's duties held back_factor times as
+             long), decides on its own move beyond the noise,
              else the run stops (UNSHOWN), never on the sign of a move within the noise
              (seed 12's trial 246 at 3 m); the marker unseen for
              probe_gap_s (the robot stands): the probe's clock stops meanwhile, but for the
