@@ -722,12 +722,13 @@ class Servo:
         hit = run_fault(cells, s.z, s.x, cmd.left, cmd.right, h, spread, travel, body,
                         self.cfg.wheelbase_m)
         what = "probe" if cmd.phase == Phase.PROBE else "reversed leg" if back else "drive"
-        # the probe's second leg (far away, its first leg's move within the noise) runs back
-        # through the start and as far beyond it: facing the other way, it goes where neither
-        # leg's check along the facing looked (the first leg's covered its start's run-down
-        # alone), so it is checked the other way too, within its own travel (it is stopped,
-        # as here, the frame it comes within that): acquire.py, Acquisition.second_leg
-        second = cmd.phase == Phase.PROBE and self.acquisition.second_leg
+        # the probe, its facing not yet shown, may run either way on either leg: its first
+        # leg, if the facing is wrong, goes the other way until its move shows that (seed 13
+        # #157 backed 8 cm toward the wall unchecked); its second (far away, the first leg's
+        # move within the noise) runs back through the start and as far beyond it. So it is
+        # checked the other way too, within its own travel (it is stopped, as here, the frame
+        # it comes within that): acquire.py, Acquisition.either_way
+        second = cmd.phase == Phase.PROBE and self.acquisition.either_way
         if hit is None and (cmd.phase != Phase.PROBE or second) and not facing_shown(
                 self.heading, c.facing_away):
             # facing the other way, it runs on until its travel shows the way (Heading.way),
@@ -817,12 +818,14 @@ class Servo:
             # disc on the wall): acquire again, leaving it out
             self._statics.append((self.last_pair.left.u, self.last_pair.left.v,
                                   self.geometry.depth_m(self.last_pair.disparity)))
-            self.notes.append(f"the marker seen at ({self.last_pair.left.u:.0f}, "
-                              f"{self.last_pair.left.v:.0f}) px did not move with the robot: "
-                              f"looking for another")
+            left_out = (f"the marker seen at ({self.last_pair.left.u:.0f}, "
+                        f"{self.last_pair.left.v:.0f}) px did not move with the robot")
+            self.notes.append(f"{left_out}: looking for another")
             self.estimator.forget()
             self.last_pair = None
-            self.acquisition = Acquisition(self.cfg.acquire)
+            # its search failing says so, not "never seen" (seed 13: 8 of the 14 "never
+            # seen" had been seen, and left out here): acquire.py, Acquisition.again
+            self.acquisition = Acquisition(self.cfg.acquire, again=f"{left_out}, left out")
             return Command(0, 0, Phase.FIND, None)
         if acq.fault:
             self.stop_reason = acq.fault

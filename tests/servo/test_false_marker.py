@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 
 from host.camera.source import StereoFrame
+from host.servo.acquire import NOT_FOUND_AGAIN
 from host.servo.loop import Servo
 from host.servo.marker import MarkerPair, marker_candidates
 from host.sim.faults import Event, WorldFaults
@@ -41,7 +42,9 @@ def test_a_look_alike_that_does_not_move_when_the_robot_is_driven_is_left_out() 
         sim.world.robot.marker_hidden = True
         with_look_alike(sim, lambda s: True, du=40, dv=-20, disparity=8.0, radius=4.0)
         sim.run(20.0)
-        assert sim.servo.outcome() == ("stopped", "the marker was never seen")
+        kind, why = sim.servo.outcome()
+        assert kind == "stopped" and why.startswith(NOT_FOUND_AGAIN), why  # not "never seen"
+        assert "did not move with the robot" in why
         assert any("did not move with the robot" in n for n in sim.servo.notes)
         assert sim.emulator.motors() == (0, 0)
         assert abs(sim.world.robot.z_m - 0.9) < 0.15  # the probe drove it blind that far
