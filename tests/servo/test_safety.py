@@ -95,21 +95,25 @@ def test_a_probe_started_again_drives_within_probe_s_in_all() -> None:
     what one probe allows. Now the clock is probe_s in all: the second start decides on its
     own sightings (not moved: a look-alike) when the first's time and its own make probe_s."""
     cfg = AcquireConfig()
+    # the sighting's disparity as the Minoru gives it at 1.62 m (fB 25.56 px m): near enough
+    # that "did not move" needs no second leg (three of its noise under 2 x probe_m; beyond
+    # ~2 m the far rule drives a second leg back through the start, test_probe_far_still)
+    disparity = 25.56 / 1.62
     acq = Acquisition(cfg)
     t, dt = 0.0, 0.066
     while acq.phase != Phase.PROBE:  # find and measure, standing at 1.62 m
         t += dt
-        acq.update(t, (1.62, 0.3), 11.0)
+        acq.update(t, (1.62, 0.3), disparity)
     driven = 0.0
     while t < 0.9 + dt / 2:  # the first start, cut short after 0.9 s
         t += dt
-        order = acq.update(t, (1.62, 0.3), 11.0)
+        order = acq.update(t, (1.62, 0.3), disparity)
         driven += dt if order.left else 0.0
     acq.interrupted(t + dt)
     t += 0.2
     while not acq.fault and t < 10.0:  # the second start, to its end
         t += dt
-        order = acq.update(t, (1.62, 0.3), 11.0)
+        order = acq.update(t, (1.62, 0.3), disparity)
         driven += dt if order.left else 0.0
     assert acq.fault == NOT_MOVED
     assert driven <= cfg.probe_s + dt
