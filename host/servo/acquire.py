@@ -44,6 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from host.servo.phase import Phase
+from host.servo.robot_model import REACT_S
 
 NEVER_SEEN = "the marker was never seen"
 NOT_MOVED = "the marker did not move when the robot was driven"
@@ -67,7 +68,7 @@ class AcquireConfig:
     probe_m: float = 0.02
     probe_s: float = 1.5  # a robot that can move has moved by then
     probe_gap_s: float = 0.3  # the marker unseen this long in the probe: its clock stops
-    run_down_s: float = 0.33  # of such a gap still counted: the last drive's reaction and
+    run_down_s: float = REACT_S  # of such a gap still counted: the last drive's reaction and
     # the wheels' run-down moved the robot on (the servo's react_s)
     floor_px: float = 0.1  # a sighting's disparity noise at least (px): far sightings err
     # together for many frames, by 0.23-0.25 px in jumps (seed 12 #246, seed 11 #117 at 3 m),

@@ -50,6 +50,7 @@ import numpy as np
 
 from host.servo.clearance import Body, in_the_way, own_body, run_fault
 from host.servo.phase import Phase
+from host.servo.robot_model import MAX_SPEED_MPS, REACT_S, WHEELBASE_M
 
 LINE_BLOCKED = "the robot's line passes through the object"
 PUSHED = "pushed sideways onto the object while holding"
@@ -114,9 +115,11 @@ class ControlConfig:
     slow_duty: int = 220
     slow_spread_deg: float = 15.0
     slow_lag_s: float = 0.6
-    check_react_s: float = 0.33  # the servo's check: its reaction and run-down (loop react_s)
-    max_speed_mps: float = 0.4  # the robot's speed at full duty (estimator max_speed_mps)
-    wheelbase_m: float = 0.14  # the wheels' track (loop wheelbase_m)
+    # the servo's check as the servo runs it (the Servo sets these from its own configs:
+    # ServoConfig.react_s and wheelbase_m, EstimatorConfig.max_speed_mps)
+    check_react_s: float = REACT_S
+    max_speed_mps: float = MAX_SPEED_MPS
+    wheelbase_m: float = WHEELBASE_M
 
 
 @dataclass(frozen=True)

@@ -38,6 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from host.camera.geometry import Geometry
+from host.servo.robot_model import MAX_SPEED_MPS
 
 AGAINST, STILL = "against", "still"
 OUTSIDE = "the marker is seen only where the robot cannot be"
@@ -45,7 +46,7 @@ OUTSIDE = "the marker is seen only where the robot cannot be"
 
 @dataclass(frozen=True)
 class EstimatorConfig:
-    max_speed_mps: float = 0.4  # the robot's speed at full duty, with room
+    max_speed_mps: float = MAX_SPEED_MPS  # the robot's speed at full duty, with room
     drift_mps: float = 0.03  # motion while told to stand (a push, a slope)
     run_down_s: float = 0.35  # actuation latency and the wheels' run-down after a stop
     margin_m: float = 0.04  # always allowed: the card's offset from the turn axis, blur

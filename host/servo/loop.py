@@ -110,6 +110,7 @@ from host.servo.rereference import (
     target_shift_rows,
 )
 from host.servo.rig import reference_image, vertical_shift_px
+from host.servo.robot_model import REACT_S, WHEELBASE_M
 from host.servo.snapshot import Observer, Snapshot, link_stats
 from host.servo.timing import FrameTiming, TimingConfig
 from host.servo.tracker import TargetTracker, TrackerConfig, with_target
@@ -187,8 +188,8 @@ class ServoConfig:
     acquire_tries: int = 3  # look-alikes that do not move, left out one after the other
     lane_width_px: int = 320  # the lane is watched on frames scaled down to about this width
     ring_ratio: float = RING_RATIO  # the marker's light ring, in disc radii (as printed)
-    react_s: float = 0.33  # a command's reaction and the wheels' run-down (the view's check)
-    wheelbase_m: float = 0.14  # the wheels' track: a duty difference bends the path
+    react_s: float = REACT_S  # a command's reaction and the wheels' run-down (the view's check)
+    wheelbase_m: float = WHEELBASE_M  # the wheels' track: a duty difference bends the path
     fixed_check: bool = True  # every motion against every other fixed object, in the plane
     # (Servo._fixed_fault); False: the check before it (a drive's path along the depth axis)
     timing: TimingConfig = field(default_factory=TimingConfig)
@@ -251,6 +252,10 @@ class Servo:
         """overrides: fields of ServoConfig (marker_kind=, marker_radius_m=, full_map= ...)."""
         self.cfg = dataclasses.replace(config or ServoConfig(), **overrides)
         self.source, self.link, self.params = source, link, params
+        # the controller's look-ahead models this servo's check: its reaction, speed and track
+        control = dataclasses.replace(control, check_react_s=self.cfg.react_s,
+                                      max_speed_mps=self.cfg.estimator.max_speed_mps,
+                                      wheelbase_m=self.cfg.wheelbase_m)
         self.geometry, self.control, self.clock = geometry, control, clock
         self.timing = FrameTiming(self.cfg.timing)
         self.frozen = FrozenSensors()
