@@ -993,12 +993,16 @@ class Servo:
         if rec.kind != BESIDE:  # another wait took over (a reset, a moved camera): its own
             self.backoff = None  # way back re-acquires the robot
             return Command(0, 0, Phase.RECOVER, None)
-        gap = None
+        gap, pushed = None, 0.0
         if lateral is not None and c.keep_out is not None:
             x0, x1 = c.keep_out  # the body's clearance across from the object's extent
             gap = max(lateral - x1, x0 - lateral) - c.cfg.half_width_m
+            fit = c.drift()  # the push fitted while it stood beside the object, toward its side
+            if fit is not None and not x0 <= lateral <= x1:
+                toward = -fit[2] if lateral > x1 else fit[2]
+                pushed = max(0.0, toward) * c.cfg.push_horizon_s
         left, right = b.update(t, depth, gap, c.target_m, self.tracker_confirmed, c.facing_away,
-                               c.trim)
+                               c.trim, pushed)
         if b.outcome == DONE:
             rec.update(t, True)
             self.backoff = None

@@ -198,17 +198,28 @@ class BackOff:
         self.seen_t: float | None = None  # the card last seen
 
     def update(self, t: float, z: float | None, gap: float | None, target_m: float,
-               confirmed: bool, facing_away: bool, trim: float) -> tuple[int, int]:
+               confirmed: bool, facing_away: bool, trim: float,
+               pushed_m: float = 0.0) -> tuple[int, int]:
         """z: the robot's depth this frame at t (None: not seen, it stands; unseen unseen_s
         once it has moved, the back-off ends: the re-acquisition looks for the card, its
         spin checked as any); gap: the body's clearance across from the object's extent
         (m, < 0 across it; None: not known; within side_m, no safe way back); target_m
-        the object's depth, confirmed when measured again since the back-off began."""
+        the object's depth, confirmed when measured again since the back-off began.
+        pushed_m: how far the sideways drift fitted while the robot stood beside the object
+        carries the body toward the object's side within the hold's push horizon (0: none,
+        or the body across the object's extent). Standing for the re-measure with a gap
+        below it, the push would bring the body onto the side before a back-off could begin
+        and clear it: no safe way back (seed 14 trial 162: 1.9 cm closing at 0.9 cm/s, the
+        re-measure not in 2.6 s)."""
         if z is not None:
             self.seen_t = t
         elif self.start_z is not None and self.seen_t is not None and \
                 t - self.seen_t > self.cfg.unseen_s and not self.outcome:
             self.outcome = DONE
+        if not self.outcome and self.start_z is None and not confirmed and \
+                gap is not None and pushed_m > 0 and gap < pushed_m:
+            self.outcome = ("no safe way back: pushed toward the object's side while its "
+                            "depth is measured again")
         if self.outcome or z is None or not confirmed:
             return 0, 0
         e = z - target_m
