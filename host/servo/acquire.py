@@ -138,12 +138,6 @@ class Acquisition:
         never looked), so the clearance check looks both ways."""
         return self.phase == Phase.PROBE and self.facing_away is None
 
-    @property
-    def second_leg(self) -> bool:
-        """What loop.py reads for the probe's check both ways (named when only the second leg
-        had it): now either_way, the first leg too (issue 23)."""
-        return self.either_way
-
     def update(self, t: float, position: tuple[float, float] | None,
                disparity: float | None, noise_m: float = 0.0) -> Order:
         """The frame at t: the robot's (depth, lateral) in m from the accepted sighting and

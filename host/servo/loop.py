@@ -733,13 +733,13 @@ class Servo:
         # move within the noise) runs back through the start and as far beyond it. So it is
         # checked the other way too, within its own travel (it is stopped, as here, the frame
         # it comes within that): acquire.py, Acquisition.either_way
-        second = cmd.phase == Phase.PROBE and self.acquisition.either_way
-        if hit is None and (cmd.phase != Phase.PROBE or second) and not facing_shown(
+        either = cmd.phase == Phase.PROBE and self.acquisition.either_way
+        if hit is None and (cmd.phase != Phase.PROBE or either) and not facing_shown(
                 self.heading, c.facing_away):
             # facing the other way, it runs on until its travel shows the way (Heading.way),
             # then stops within the same stopping distance
             g = self.geometry
-            show = 0.0 if second else self.heading.way_sigmas * depth_noise_m(
+            show = 0.0 if either else self.heading.way_sigmas * depth_noise_m(
                 s.z, est.sigma_px, g.focal_px, g.baseline_m)
             hit = run_fault(cells, s.z, s.x, cmd.left, cmd.right, h + math.pi, spread,
                             travel + show, body, self.cfg.wheelbase_m)
