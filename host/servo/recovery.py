@@ -164,6 +164,7 @@ class BackOffConfig:
     # degrees toward it; a 1 cm/s push at the back-off's ~8 cm/s is 0.12)
     side_m: float = 0.01  # the body this near the object's side (or across it): it backs
     # off only away from the face, and stands if that closes on the side level with the face
+    # (or, beyond the face, takes the body from clear of the extent to across it: behind it)
     level_m: float = 0.12  # level with the face: the body's half diagonal (0.113) reaches it
     unseen_s: float = 1.0  # the card unseen this long backing off (turned away): re-acquired
 
@@ -244,8 +245,13 @@ class BackOff:
             self.outcome = ("no safe way back: backing off either way closes on its side"
                             if self.flipped else
                             "no safe way back: backing off closes on the object's side")
-        elif level and gap is not None and gap < 0 <= (self.start_gap or 0.0):
-            self.outcome = "no safe way back: the body is at the object's side"
+        elif (level or e > 0) and gap is not None and gap < 0 <= (self.start_gap or 0.0):
+            # beyond the face the body coming across the object's extent goes behind it:
+            # where a box's own depth is, which the face hides from the camera, where an
+            # object pushed farther lands (seed 14 trial 609), and no lane watch looks there
+            self.outcome = ("no safe way back: the body is at the object's side" if level else
+                            "no safe way back: backing off takes the body behind the "
+                            "object's face")
         elif abs(z - self.start_z) > cfg.max_m:
             self.outcome = f"no safe way back: {cfg.max_m:.2f} m backed off and still beside it"
         elif not self.deeper and z < cfg.camera_m:
