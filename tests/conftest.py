@@ -5,11 +5,20 @@ from __future__ import annotations
 
 import contextlib
 import os
+import signal
 import time
 from pathlib import Path
 
 import pytest
 from numba.core import event
+
+# A suite started in the background of a script (bash's `cmd &` without job control) has SIGINT
+# ignored, and every program the tests start inherits that: the tests that end one with Ctrl-C
+# (test_cli_signals, test_sim_watch, the resumed campaign in test_trials) then wait in vain (a
+# fresh-clone run under `nohup bash -c '... &'` failed those four). The default handler here
+# becomes the default action in each program started (exec resets a handler, not an ignore).
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def _middlebury() -> Path | None:
