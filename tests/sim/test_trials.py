@@ -161,11 +161,7 @@ def _host(*args: str) -> list[str]:
 
 
 def test_an_interrupted_campaign_resumed_gives_the_straight_runs_summary(tmp_path) -> None:
-    # 8 trials: with the cameras calibrated before the trials (campaign.py), two workers' first
-    # trials end within moments of each other, and a fresh-clone CI at load ~6 saw all of 3
-    # written before the interrupt arrived (it ended 0)
-    n = 8
-    plan = ["--trials", str(n), "--seed", "4", "--nominal", "--workers", "2"]
+    plan = ["--trials", "3", "--seed", "4", "--nominal", "--workers", "2"]
     straight = subprocess.run(_host(*plan, "--json", str(tmp_path / "s.json")),
                               capture_output=True, text=True, timeout=600)
     assert straight.returncode == 0, straight.stderr
@@ -180,14 +176,14 @@ def test_an_interrupted_campaign_resumed_gives_the_straight_runs_summary(tmp_pat
     _, err = proc.communicate(timeout=120)
     assert proc.returncode == 130, err
     kept = json.loads(part.read_text())
-    assert not kept["complete"] and 1 <= len(kept["trials"]) < n
+    assert not kept["complete"] and 1 <= len(kept["trials"]) < 3
     again = subprocess.run(_host(*plan, "--json", str(part), "--csv", str(rows), "--resume"),
                            capture_output=True, text=True, timeout=600)
     assert again.returncode == 0, again.stderr
     assert f"({len(kept['trials'])} done before" in again.stdout
     a, b = json.loads((tmp_path / "s.json").read_text()), json.loads(part.read_text())
     assert b["complete"] and a["summary"] == b["summary"] and a["trials"] == b["trials"]
-    assert rows.read_text().count("\n") == n + 1  # the header and one row a trial
+    assert rows.read_text().count("\n") == 4  # the header and one row a trial
 
 
 def test_resume_refuses_another_campaigns_file(tmp_path) -> None:
