@@ -19,6 +19,7 @@ from host.errors import HostError
 from host.files import write_text_atomic
 from host.sim import trial_backends as backends
 from host.sim.run import CalibKey, _calibration, keep_calibration
+from host.sim.run import calibration_key as run_calibration_key
 from host.sim.trial_stats import lines, plot, summary
 from host.sim.trials import Trial, run_trial, trial_setup
 from host.stereo.params import MatcherParams
@@ -122,11 +123,8 @@ Job = tuple[int, int, tuple[int, int], MatcherParams, bool]
 
 
 def calibration_key(job: Job) -> CalibKey | None:
-    """The camera calibration (host.sim.run._calibration's arguments) a trial needs, or None."""
-    s = trial_setup(*job)
-    if not any(s.faults.camera.distortion):
-        return None
-    return s.size, s.faults.camera.distortion, s.seed if s.calib_seed is None else s.calib_seed
+    """The camera calibration a trial needs (host.sim.run.calibration_key), or None."""
+    return run_calibration_key(trial_setup(*job))
 
 
 def _calibrate(key: CalibKey) -> tuple[CalibKey, Any]:

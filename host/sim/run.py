@@ -93,9 +93,9 @@ def simulation(setup: Setup = Setup(), reference: bool = True) -> Iterator[SimRu
                    drive_budget_s=max(SERVO_DRIVE_BUDGET_S, 2 * reply_timeout_s),
                    rng=random.Random(setup.seed)) as link:
         geometry = world.geometry
-        if any(faults.camera.distortion):  # rectify as a user would: with a calibration
-            seed = setup.seed if setup.calib_seed is None else setup.calib_seed
-            calib = _calibration(setup.size, faults.camera.distortion, seed)
+        key = calibration_key(setup)
+        if key is not None:  # rectify as a user would: with a calibration
+            calib = _calibration(*key)
             source.rectify = SimRectifier(calib, source)  # the Rectifier's images
             geometry = calib.geometry
         servo = Servo(source, link, setup.params, geometry, setup.control, clock=source.clock)
@@ -106,6 +106,15 @@ def simulation(setup: Setup = Setup(), reference: bool = True) -> Iterator[SimRu
 
 
 CalibKey = tuple[tuple[int, int], tuple[float, float], int]  # size, lenses, seed
+
+
+def calibration_key(setup: Setup) -> CalibKey | None:
+    """The camera calibration a run needs (_calibration's arguments), or None: lenses without
+    distortion are used as they are."""
+    distortion = setup.faults.camera.distortion
+    if not any(distortion):
+        return None
+    return setup.size, distortion, setup.seed if setup.calib_seed is None else setup.calib_seed
 
 
 @functools.lru_cache(maxsize=32)
