@@ -167,6 +167,7 @@ class BackOffConfig:
     # (or, beyond the face, takes the body from clear of the extent to across it: behind it)
     level_m: float = 0.12  # level with the face: the body's half diagonal (0.113) reaches it
     unseen_s: float = 1.0  # the card unseen this long backing off (turned away): re-acquired
+    beyond_m: float = 0.02  # the robot this far beyond the object's face backs off deeper
 
 
 DONE = "done"
@@ -227,7 +228,7 @@ class BackOff:
         cfg = self.cfg
         first = self.start_z is None
         if first:
-            self.deeper, self.start_z, self.start_gap = e > 0.02, z, gap
+            self.deeper, self.start_z, self.start_gap = e > cfg.beyond_m, z, gap
         if abs(e) >= self.block_m + (0.0 if first else cfg.clear_m):
             self.outcome = DONE  # out of the object's depth (measured again: never in it)
             return 0, 0
