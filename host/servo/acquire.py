@@ -51,6 +51,9 @@ NOT_MOVED = "the marker did not move when the robot was driven"
 NOT_FOUND_AGAIN = "the marker was not found again"
 UNSHOWN = ("the probe could not show which way the robot faces: its move there and back stayed "
            "within the depth noise at {:.2f} m ({:.1f} cm)")
+BLIND = ("the probe's second leg, back at its start, did not show the sighting going with the "
+         "robot ({:.1f} cm, under {:.1f}): it is not driven on beyond its start on a sighting "
+         "that may be a look-alike's")
 PROBED_OUT = ("the probe move, started again, ran its {:.1f} s in all without a sighting "
               "proven to be the robot's")
 
@@ -273,6 +276,16 @@ class Acquisition:
                                              and not self._within_noise(noise_m)):
             self.fault = NOT_MOVED  # nothing moved by then: not the robot's marker
             return Order(0, 0, Phase.PROBE)
+        if self._leg == 2 and self._still and not self._shown_so_far(dz, noise_m) \
+                and self._at_start() and moved < cfg.still_factor * cfg.probe_m:
+            # back at the start after a first leg whose sightings showed no move: beyond it
+            # only on a move back that shows the sighting going with the robot (the reviewer's
+            # "a far look-alike gets a blind second leg": the checks look where the sighting
+            # is, and a look-alike's test drove the unseen robot the first leg's reach on
+            # beyond its start, onto ground nobody had looked at)
+            self.fault = NOT_MOVED if moved < cfg.probe_m else BLIND.format(
+                100 * moved, 100 * cfg.still_factor * cfg.probe_m)
+            return Order(0, 0, Phase.PROBE)
         # the heading is the sign of the move in depth, so that move alone decides (a far
         # sighting's sideways noise says nothing of it), and only beyond the noise there
         # (_shown): at 3 m sightings err together by 7-8 cm for frames on end, a move of a
@@ -309,6 +322,17 @@ class Acquisition:
         self._drive = (t, duty)
         duty *= self.direction
         return Order(duty, duty, Phase.PROBE)
+
+    def _shown_so_far(self, dz: float, noise_m: float) -> bool:
+        """Whether the track's move dz (m) already shows its sign (_shown; ten sightings)."""
+        return len(self._track) >= 10 and self._shown(
+            dz, self._track[-1][1], float(np.median(self._disp[-5:])), noise_m)
+
+    def _at_start(self) -> bool:
+        """The second leg has held its duties, in rising order, as long in all as the first
+        leg held its own: the robot is back at most at the probe's start (its slower duties
+        first, so short of it rather than beyond)."""
+        return sum(self._back.values()) >= sum(self._levels.values()) - 1e-9
 
     def _within_noise(self, noise_m: float) -> bool:
         """Whether a move under probe_m is within the noise of the track's last sightings
