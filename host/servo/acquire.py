@@ -80,6 +80,9 @@ class AcquireConfig:
     # three of a sighting's noise exceed this many probe_m (beyond ~2 m: seed 13's trial 42
     # backed 9 cm at 3.0 m, its sightings showed under 2 cm; a look-alike at 1.5 m, 2.6 cm
     # there, is still left out by the first leg: test_false_marker)
+    spin_s: float = 1.0  # the spin test's turn each way at search_duty (~45 degrees)
+    spin_drop: float = 0.1  # the card's width-to-height ratio falls this much (and four of
+    # its standing spread) when the robot under it turns that far: the card is the robot's
     back_factor: float = 2.0  # the second leg's time at each of the first's duties, of the
     # first's (back through the start and as far beyond it: the robot stays within the first
     # leg's reach of it, as the first leg's own time at each duty sets its travel)
@@ -125,6 +128,11 @@ class Acquisition:
         self._drive: tuple[float, int] | None = None  # the last drive order: (t, |duty|)
         self.direction = 1  # the probe's: +1 forward, -1 backward (set by the servo)
         self._seen_t = -math.inf  # the last sighting's time
+        self.aspects: list[float] = []  # the standing card's width-to-height ratios
+        self._spin_why = ""  # the refused probe a spin test runs for ("" if none)
+        self._spun = False  # the test ran (once an acquisition)
+        self._spin_t0: float | None = None
+        self._turned: list[float] = []  # the card's ratios while the robot turns
         self.spent_s = spent_s  # the probe's driving before its last start (s)
 
     @property
@@ -142,10 +150,12 @@ class Acquisition:
         return self.phase == Phase.PROBE and self.facing_away is None
 
     def update(self, t: float, position: tuple[float, float] | None,
-               disparity: float | None, noise_m: float = 0.0) -> Order:
+               disparity: float | None, noise_m: float = 0.0,
+               aspect: float | None = None) -> Order:
         """The frame at t: the robot's (depth, lateral) in m from the accepted sighting and
         its disparity (px), or None when it was not seen; noise_m: a sighting's depth noise
-        (m, standard deviation; the probe's move must be well beyond it)."""
+        (m, standard deviation; the probe's move must be well beyond it); aspect: the seen
+        disc's width-to-height ratio (the spin test, refused)."""
         if self._t0 is None:
             self._t0 = t
         if self.phase == Phase.FIND:
@@ -156,6 +166,8 @@ class Acquisition:
                 self.disparities.append(disparity)
                 if position is not None:
                     self.depths.append(position[0])
+                if aspect is not None:
+                    self.aspects.append(aspect)
                 if len(self.disparities) >= self.cfg.noise_frames:
                     self._begin(Phase.PROBE if self.probes else Phase.DONE, t)
             elif t - max(self._t0, self._seen_t) > self.cfg.find_wait_s:
@@ -163,11 +175,58 @@ class Acquisition:
                 # a glimpse): find it again, spinning if need be, rather than wait for ever
                 self.disparities.clear()
                 self.depths.clear()
+                self.aspects.clear()
                 self._begin(Phase.FIND, t)
             return Order(0, 0, Phase.MEASURE)
+        if self.phase == Phase.PROBE and self._spin_why:
+            return self._spin_test(t, aspect if position is not None else None)
         if self.phase == Phase.PROBE:
             return self._probe(t, position, disparity, noise_m)
         return Order(0, 0, Phase.DONE)
+
+    def refused(self, why: str) -> bool:
+        """The probe's first leg, its facing unshown, refused by a fixed object one way or the
+        other (why: the check's reason; the robot stands this frame): where the sighting is,
+        a straight move either way would close on it if the robot faced the way that goes
+        there. Before the run stops, a spin test shows whether the card is the robot's at
+        all: the robot turns spin_s one way and as long back (the spin in place is checked
+        as any turn); the card's width-to-height ratio falls by spin_drop (and four of its
+        standing spread): the robot's, and the run stops with why, as before; it stays: a
+        look-alike (another robot, a disc by a box: seed 14's trials 65, 148 and 177 stopped
+        on a look-alike in front of the box at 1.8 m while the robot stood at 2-3 m), and the
+        marker "did not move" (the loop looks for another). False: no test (run once, on the
+        first leg, after five standing ratios), the run stops with why."""
+        if self.phase != Phase.PROBE or self.facing_away is not None or self._spun \
+                or self._leg != 1 or self._after is not None or len(self.aspects) < 5:
+            return False
+        self._spun, self._spin_why, self._spin_t0 = True, why, None
+        self._turned = []
+        return True
+
+    def _spin_test(self, t: float, aspect: float | None) -> Order:
+        """A frame of the spin test (refused): turn, turn back, stand the run-down, decide."""
+        cfg = self.cfg
+        if self._spin_t0 is None:
+            self._spin_t0 = t
+        el = t - self._spin_t0
+        if aspect is not None and el > cfg.run_down_s:
+            self._turned.append(aspect)
+        d = cfg.search_duty
+        if el < cfg.spin_s:
+            return Order(d, -d, Phase.PROBE)
+        if el < 2 * cfg.spin_s:
+            return Order(-d, d, Phase.PROBE)
+        if el < 2 * cfg.spin_s + cfg.run_down_s:
+            return Order(0, 0, Phase.PROBE)
+        base = float(np.median(self.aspects))
+        spread = float(np.std(self.aspects, ddof=1))
+        if len(self._turned) < 5:  # not seen turning: nothing shown either way
+            self.fault = self._spin_why
+            return Order(0, 0, Phase.PROBE)
+        runs = np.convolve(np.sort(self._turned), np.ones(3) / 3, mode="valid")
+        drop = base - float(runs[0])  # the three narrowest, against the standing ratio
+        self.fault = self._spin_why if drop >= max(cfg.spin_drop, 4 * spread) else NOT_MOVED
+        return Order(0, 0, Phase.PROBE)
 
     def driven_s(self) -> float:
         """The probe's driving time in all, its earlier starts' with this one's so far (s)."""
