@@ -31,7 +31,15 @@ way the robot faces by what a short probe move does (a pure state machine, one c
              whole move of its starts (beyond probe_m and three of a sighting's noise; a
              far robot backed 10 cm, its move not yet clear, when a stale frame restarted
              it: dev seed 105's trial 24); not within probe_s: the run stops (PROBED_OUT)
-             (skipped in a re-acquisition that knows the heading: done after the measure)
+             (skipped in a re-acquisition that knows the heading: done after the measure);
+             a second leg after a first whose sightings showed no move (under probe_m, far)
+             goes on beyond the start only on a move back of still_factor probe_m: back at
+             the start with less, NOT_MOVED under probe_m, else BLIND (a look-alike's test
+             drove the unseen robot onto ground nobody had checked: the reviewer's "blind
+             second leg"); refused by a fixed object on its first leg, the facing unshown
+             (refused, from the servo), a spin test: spin_s one way at search_duty and as
+             long back, the card narrowing by spin_drop: the robot's, the run stops as
+             before; not: a look-alike, NOT_MOVED (the servo looks for another)
     a find that fails in a re-acquisition (again: why) says so: "not found again", not
     "never seen"
 """
