@@ -31,7 +31,15 @@ way the robot faces by what a short probe move does (a pure state machine, one c
              whole move of its starts (beyond probe_m and three of a sighting's noise; a
              far robot backed 10 cm, its move not yet clear, when a stale frame restarted
              it: dev seed 105's trial 24); not within probe_s: the run stops (PROBED_OUT)
-             (skipped in a re-acquisition that knows the heading: done after the measure)
+             (skipped in a re-acquisition that knows the heading: done after the measure);
+             a second leg after a first whose sightings showed no move (under probe_m, far)
+             goes on beyond the start only on a move back of still_factor probe_m: back at
+             the start with less, NOT_MOVED under probe_m, else BLIND (a look-alike's test
+             drove the unseen robot onto ground nobody had checked: the reviewer's "blind
+             second leg"); refused by a fixed object on its first leg, the facing unshown
+             (refused, from the servo), a spin test: spin_s one way at search_duty and as
+             long back, the card narrowing by spin_drop: the robot's, the run stops as
+             before; not: a look-alike, NOT_MOVED (the servo looks for another)
     a find that fails in a re-acquisition (again: why) says so: "not found again", not
     "never seen"
 """
@@ -51,6 +59,9 @@ NOT_MOVED = "the marker did not move when the robot was driven"
 NOT_FOUND_AGAIN = "the marker was not found again"
 UNSHOWN = ("the probe could not show which way the robot faces: its move there and back stayed "
            "within the depth noise at {:.2f} m ({:.1f} cm)")
+BLIND = ("the probe's second leg, back at its start, did not show the sighting going with the "
+         "robot ({:.1f} cm, under {:.1f}): it is not driven on beyond its start on a sighting "
+         "that may be a look-alike's")
 PROBED_OUT = ("the probe move, started again, ran its {:.1f} s in all without a sighting "
               "proven to be the robot's")
 
@@ -77,6 +88,10 @@ class AcquireConfig:
     # three of a sighting's noise exceed this many probe_m (beyond ~2 m: seed 13's trial 42
     # backed 9 cm at 3.0 m, its sightings showed under 2 cm; a look-alike at 1.5 m, 2.6 cm
     # there, is still left out by the first leg: test_false_marker)
+    spin_s: float = 1.0  # the spin test's turn each way at search_duty (~45 degrees)
+    spin_drop: float = 0.1  # a card standing within a quarter of this (four of its spread),
+    # seen through the turn, whose width-to-height ratio then fell under half of it, did not
+    # turn with the robot (~30 degrees: 0.13): a look-alike's; else the refusal stands
     back_factor: float = 2.0  # the second leg's time at each of the first's duties, of the
     # first's (back through the start and as far beyond it: the robot stays within the first
     # leg's reach of it, as the first leg's own time at each duty sets its travel)
@@ -122,6 +137,11 @@ class Acquisition:
         self._drive: tuple[float, int] | None = None  # the last drive order: (t, |duty|)
         self.direction = 1  # the probe's: +1 forward, -1 backward (set by the servo)
         self._seen_t = -math.inf  # the last sighting's time
+        self.aspects: list[float] = []  # the standing card's width-to-height ratios
+        self._spin_why = ""  # the refused probe a spin test runs for ("" if none)
+        self._spun = False  # the test ran (once an acquisition)
+        self._spin_t0: float | None = None
+        self._turned: list[float] = []  # the card's ratios while the robot turns
         self.spent_s = spent_s  # the probe's driving before its last start (s)
 
     @property
@@ -139,10 +159,12 @@ class Acquisition:
         return self.phase == Phase.PROBE and self.facing_away is None
 
     def update(self, t: float, position: tuple[float, float] | None,
-               disparity: float | None, noise_m: float = 0.0) -> Order:
+               disparity: float | None, noise_m: float = 0.0,
+               aspect: float | None = None) -> Order:
         """The frame at t: the robot's (depth, lateral) in m from the accepted sighting and
         its disparity (px), or None when it was not seen; noise_m: a sighting's depth noise
-        (m, standard deviation; the probe's move must be well beyond it)."""
+        (m, standard deviation; the probe's move must be well beyond it); aspect: the seen
+        disc's width-to-height ratio (the spin test, refused)."""
         if self._t0 is None:
             self._t0 = t
         if self.phase == Phase.FIND:
@@ -153,6 +175,8 @@ class Acquisition:
                 self.disparities.append(disparity)
                 if position is not None:
                     self.depths.append(position[0])
+                if aspect is not None:
+                    self.aspects.append(aspect)
                 if len(self.disparities) >= self.cfg.noise_frames:
                     self._begin(Phase.PROBE if self.probes else Phase.DONE, t)
             elif t - max(self._t0, self._seen_t) > self.cfg.find_wait_s:
@@ -160,11 +184,63 @@ class Acquisition:
                 # a glimpse): find it again, spinning if need be, rather than wait for ever
                 self.disparities.clear()
                 self.depths.clear()
+                self.aspects.clear()
                 self._begin(Phase.FIND, t)
             return Order(0, 0, Phase.MEASURE)
+        if self.phase == Phase.PROBE and self._spin_why:
+            return self._spin_test(t, aspect if position is not None else None)
         if self.phase == Phase.PROBE:
             return self._probe(t, position, disparity, noise_m)
         return Order(0, 0, Phase.DONE)
+
+    def refused(self, why: str) -> bool:
+        """The probe's first leg, its facing unshown, refused by a fixed object one way or the
+        other (why: the check's reason; the robot stands this frame): where the sighting is,
+        a straight move either way would close on it if the robot faced the way that goes
+        there. Before the run stops, a spin test shows whether the card is the robot's at
+        all: the robot turns spin_s one way and as long back (the spin in place is checked
+        as any turn); the card's width-to-height ratio falls by spin_drop (and four of its
+        standing spread): the robot's, and the run stops with why, as before; it stays: a
+        look-alike (another robot, a disc by a box: seed 14's trials 65, 148 and 177 stopped
+        on a look-alike in front of the box at 1.8 m while the robot stood at 2-3 m), and the
+        marker "did not move" (the loop looks for another). False: no test (run once, on the
+        first leg, after five standing ratios), the run stops with why."""
+        if self.phase != Phase.PROBE or self.facing_away is not None or self._spun \
+                or self._leg != 1 or self._after is not None or len(self.aspects) < 5:
+            return False
+        self._spun, self._spin_why, self._spin_t0 = True, why, None
+        self._turned = []
+        return True
+
+    def _spin_test(self, t: float, aspect: float | None) -> Order:
+        """A frame of the spin test (refused): turn, turn back, stand the run-down, decide."""
+        cfg = self.cfg
+        if self._spin_t0 is None:
+            self._spin_t0 = t
+        el = t - self._spin_t0
+        if el > cfg.run_down_s:
+            self._turned.append(math.nan if aspect is None else aspect)
+        d = cfg.search_duty
+        if el < cfg.spin_s:
+            return Order(d, -d, Phase.PROBE)
+        if el < 2 * cfg.spin_s:
+            return Order(-d, d, Phase.PROBE)
+        if el < 2 * cfg.spin_s + cfg.run_down_s:
+            return Order(0, 0, Phase.PROBE)
+        base = float(np.median(self.aspects))
+        spread = float(np.std(self.aspects, ddof=1))
+        seen = np.array([a for a in self._turned if not math.isnan(a)])
+        self.fault = self._spin_why  # the robot's, or not shown either way: stops as before
+        if len(seen) < 5 or len(seen) < 0.8 * len(self._turned) or 4 * spread > cfg.spin_drop:
+            # the card lost while turning (beyond ~40 degrees the disc finder drops it), or
+            # its standing ratio too noisy for the turn to show (far: seed 14's 221 at 3 m,
+            # 0.04 a frame, narrowed 0.11 in a 30-degree turn): no look-alike is shown
+            return Order(0, 0, Phase.PROBE)
+        runs = np.convolve(np.sort(seen), np.ones(3) / 3, mode="valid")
+        drop = base - float(runs[0])  # the three narrowest, against the standing ratio
+        if drop < cfg.spin_drop / 2:  # it stayed as it stood: not the robot's card
+            self.fault = NOT_MOVED
+        return Order(0, 0, Phase.PROBE)
 
     def driven_s(self) -> float:
         """The probe's driving time in all, its earlier starts' with this one's so far (s)."""
@@ -273,6 +349,16 @@ class Acquisition:
                                              and not self._within_noise(noise_m)):
             self.fault = NOT_MOVED  # nothing moved by then: not the robot's marker
             return Order(0, 0, Phase.PROBE)
+        if self._leg == 2 and self._still and not self._shown_so_far(dz, noise_m) \
+                and self._at_start() and moved < cfg.still_factor * cfg.probe_m:
+            # back at the start after a first leg whose sightings showed no move: beyond it
+            # only on a move back that shows the sighting going with the robot (the reviewer's
+            # "a far look-alike gets a blind second leg": the checks look where the sighting
+            # is, and a look-alike's test drove the unseen robot the first leg's reach on
+            # beyond its start, onto ground nobody had looked at)
+            self.fault = NOT_MOVED if moved < cfg.probe_m else BLIND.format(
+                100 * moved, 100 * cfg.still_factor * cfg.probe_m)
+            return Order(0, 0, Phase.PROBE)
         # the heading is the sign of the move in depth, so that move alone decides (a far
         # sighting's sideways noise says nothing of it), and only beyond the noise there
         # (_shown): at 3 m sightings err together by 7-8 cm for frames on end, a move of a
@@ -309,6 +395,17 @@ class Acquisition:
         self._drive = (t, duty)
         duty *= self.direction
         return Order(duty, duty, Phase.PROBE)
+
+    def _shown_so_far(self, dz: float, noise_m: float) -> bool:
+        """Whether the track's move dz (m) already shows its sign (_shown; ten sightings)."""
+        return len(self._track) >= 10 and self._shown(
+            dz, self._track[-1][1], float(np.median(self._disp[-5:])), noise_m)
+
+    def _at_start(self) -> bool:
+        """The second leg has held its duties, in rising order, as long in all as the first
+        leg held its own: the robot is back at most at the probe's start (its slower duties
+        first, so short of it rather than beyond)."""
+        return sum(self._back.values()) >= sum(self._levels.values()) - 1e-9
 
     def _within_noise(self, noise_m: float) -> bool:
         """Whether a move under probe_m is within the noise of the track's last sightings
