@@ -816,7 +816,8 @@ class Servo:
             if acq.phase == Phase.MEASURE:  # probe the way the robot must go if it faces away
                 assert self.controller is not None
                 acq.direction = 1 if position[0] < self.controller.target_m else -1
-        order = acq.update(t, position, None if position is None else d, noise_m)
+        aspect = self.last_pair.left.aspect if position is not None and self.last_pair else None
+        order = acq.update(t, position, None if position is None else d, noise_m, aspect)
         if acq.fault == NOT_MOVED and self.last_pair is not None \
                 and len(self._statics) < self.cfg.acquire_tries - 1:
             # what was taken for the marker did not move with the robot (another robot, a
@@ -1277,6 +1278,8 @@ class Servo:
         self._track_heading(t, cmd)
         moving = not cmd.is_stop and cmd.phase in (Phase.DRIVE, Phase.CREEP, Phase.PROBE)
         fault = self._path_fault(frame, cmd) if moving else self._spin_fault(frame.t_left, cmd)
+        if fault.startswith(INTO_FIXED.format("probe")) and self.acquisition.refused(fault):
+            return Command(0, 0, Phase.PROBE, cmd.error_m), invalid  # a spin test first
         if fault:  # nothing to wait for: the run ends here
             self.stop_reason = self.stop_reason or fault
             self.controller.phase = Phase.STOP
