@@ -56,11 +56,12 @@ def test_a_short_leg_beside_the_object_is_reversed_with_the_card_in_view() -> No
     toward it at 0.9 cm/s, the robot must come back. It turned round, the card edge-on for
     seconds, and the servo's unseen drift check (6 s of the last drift) ended the run mid-spin.
     Within block_m of the object's depth the leg is reversed: the card stays in view every
-    frame, and the robot holds at the object's depth, never turning, its body clear."""
+    frame, and the robot holds at the object's depth, never turning, its body clear. Here 11
+    cm clear (beyond turn_slack_m's reach: the depth rule alone reverses it)."""
     ctl = Controller(1.008, ControlConfig())
     ctl.keep_out = (-0.31, -0.17)
     plant = PushedPlant(1.10, push=-0.009)
-    plant.x = -0.008
+    plant.x = 0.02
     phases, unseen, gap = set(), 0, math.inf
     while plant.t < 10 and not ctl.fault:
         obs = plant.observe()
