@@ -22,7 +22,10 @@ Then re-acquisition: driving waits for the marker; if the card is not seen after
 never came back, or the turn ended with it edge-on), the robot spins slowly on to find it.
 Where a turn in place would sweep the body into the object (beside it, near its depth), the
 robot does not turn (nor stop): it drives that leg in reverse along its line, as mode
-"reverse" does, with every check of a drive.
+"reverse" does, with every check of a drive. So it does, too, within block_m of the object's
+depth (a short leg: a spin there loses the card for seconds beside the object, where a push
+closes unseen), and where the turn's circle clears another fixed object by less than
+turn_slack_m beyond the servo's check (the body wanders in a spin): turn_tight.
 Lateral: the marker's position x = B (u - cx) / d is held on a lane: where it was first seen,
 unless that line passes the object (keep_out, the object's lateral extent at its depth, from the
 servo) closer than clearance_m, centre to side; then the lane moves to the nearer clear side.
@@ -83,6 +86,11 @@ class ControlConfig:
     block_m: float = 0.15  # within this depth of the object, the body must be clear of it
     block_margin_m: float = 0.02  # by this much (the object's edge is measured to a pixel or two)
     turn_radius_m: float = 0.115  # a turn in place sweeps this circle: half the body's diagonal
+    # a turn round takes seconds and the body wanders in it (unequal wheels, a sideways push:
+    # 2.2 cm in seed 14 trial 55's 2.4 s spin, the servo's check of its frames then ended the
+    # run): it is started only with this much more room than that check asks, else the leg is
+    # reversed (the drive's checks on every frame)
+    turn_slack_m: float = 0.03
     half_length_m: float = 0.08  # centre to front (and back): a run sweeps this rectangle
     # (clearance.swept), turned by the heading, grown by block_margin_m and half a cell
     path_margin_m: float = 0.10  # fixed objects this far beyond the target's depth are in its path
@@ -249,23 +257,35 @@ class Controller:
             cells = cells[~own_body(cells, z, x, own_m, cfg.half_width_m / 2, 2 * cfg.cell_m)]
         return cells
 
-    def sweeps(self, depth_m: float, lateral_m: float | None, aged: bool = False) -> bool:
+    def sweeps(self, depth_m: float, lateral_m: float | None, aged: bool = False,
+               slack_m: float = 0.0) -> bool:
         """Whether a turn in place here sweeps the body (a circle of turn_radius_m) within
         block_margin_m of the object's extent or of any other fixed object's cell, behind the
         robot as well as ahead (a turn sweeps the whole circle: a box a few cm farther than the
         robot's centre is as near as one in its path), but not a body standing there
         (obstacles: the sighting is then of a look-alike). aged: the object's depth is too old
         to trust (not measured again through a search; it may have moved beside the robot
-        unseen, seed 13's trial 742): its extent across is swept at any depth."""
+        unseen, seed 13's trial 742): its extent across is swept at any depth. slack_m: room
+        asked beyond that (a turn's wander, turn_tight)."""
         if lateral_m is None:
             return False
         cfg = self.cfg
-        reach = cfg.turn_radius_m + cfg.block_margin_m
+        reach = cfg.turn_radius_m + cfg.block_margin_m + slack_m
         if (aged or abs(depth_m - self.target_m) < reach) and self.overlaps(
                 lateral_m, reach - cfg.half_width_m):
             return True
         return in_the_way(self.obstacles(depth_m, lateral_m), depth_m, lateral_m, None, 0.0,
                           reach + cfg.cell_m / 2) is not None
+
+    def turn_tight(self, z: float, e: float, lateral: float | None) -> bool:
+        """Whether a turn round here is refused for a reversed leg: within block_m of the
+        object's depth (a short leg; a spin there loses the card for seconds beside the object
+        while the servo guesses its drift, and a sideways push ended seed 14's trials 7 and
+        235 in the spin: reversed, the card stays in view and the hold's own push check and
+        back-off watch it), or its circle within turn_slack_m more than the check's reach of
+        the object or another fixed object (sweeps)."""
+        cfg = self.cfg
+        return abs(e) < cfg.block_m or self.sweeps(z, lateral, slack_m=cfg.turn_slack_m)
 
     def drift(self) -> tuple[float, float, float] | None:
         """(time, lateral, lateral rate) of the robot beside the object: a line through its
@@ -381,10 +401,11 @@ class Controller:
         if forward:
             self._reversing = False
         elif cfg.mode == "turn" and not self._reversing:
-            if not self.sweeps(z, obs.lateral_m):
+            if not self.turn_tight(z, e, obs.lateral_m):
                 return self._start_turn(obs, e)
-            # a turn here would sweep the body into the object: this leg is driven in
-            # reverse instead, along the robot's line (the body checks as for any drive)
+            # a turn here would sweep the body into the object, or bring it there unseen: this
+            # leg is driven in reverse instead, along the robot's line (the body checks as for
+            # any drive, the card in view)
             self._reversing = True
         creeping = abs(e) <= cfg.creep_m
         if creeping and self.phase == Phase.CREEP and abs(zdot) < 0.004:

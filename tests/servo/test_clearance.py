@@ -167,7 +167,8 @@ def test_a_turn_in_place_that_would_sweep_the_body_into_the_object_is_not_starte
     """Beside the object, 3 cm past its depth, the body (8 cm each side of its line) is 3 cm
     clear of the object's side but a turn in place sweeps half its diagonal (11.5 cm): the
     robot does not turn there (seed 7 trial 843 and a seed-4 trial ended with the line beside
-    the box's edge) but backs in along its line. With room for the sweep it turns."""
+    the box's edge) but backs in along its line. With room for the sweep, and farther from
+    the object's depth than block_m (nearer, the short leg is reversed: turn_tight), it turns."""
     side = BOX[1] + ControlConfig().half_width_m + 0.03
     ctl = Controller(1.2, ControlConfig())
     ctl.keep_out = BOX
@@ -175,7 +176,7 @@ def test_a_turn_in_place_that_would_sweep_the_body_into_the_object_is_not_starte
     assert cmd.left < 0 and cmd.right < 0 and not ctl.fault, (cmd, ctl.fault)
     roomy = Controller(1.2, ControlConfig())
     roomy.keep_out = BOX
-    assert roomy.update(Observation(0.0, 1.23, BOX[1] + 0.15)).phase == "turn"
+    assert roomy.update(Observation(0.0, 1.40, BOX[1] + 0.15)).phase == "turn"
 
 
 def test_where_a_turn_would_sweep_into_the_object_the_robot_reverses_to_its_hold() -> None:
