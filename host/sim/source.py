@@ -328,7 +328,7 @@ class SimSource(StereoSource):
         vel = self.renderer.image_velocity()
         blur = (vel[0] * self.renderer.camera.exposure_ms / 1000,
                 vel[1] * self.renderer.camera.exposure_ms / 1000)
-        image, _ = self.renderer.view(side, with_robot, blur, t_s=began)
+        image = self.renderer.image(side, with_robot, blur, t_s=began)
         self._held[side] = (image, stamp)
         self._made[side] = (image, self.renderer.changed)
         return image, stamp
