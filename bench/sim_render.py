@@ -23,7 +23,10 @@ from tests.sim import renderer_oracle
 
 
 def ms_per_view(cls: type, camera, size: tuple[int, int], views: int, seed: int,
-                flicker: Flicker | None = None, pitch_deg: float = 0.0) -> float:
+                flicker: Flicker | None = None, pitch_deg: float = 0.0,
+                image: bool = False) -> float:
+    """CPU ms a view; image: Renderer.image (the image alone, drawn in place, as the trials'
+    camera takes it) instead of view()."""
     world = World.for_size(*size, seed=seed)
     r = cls(world, camera, seed=seed)
     r.pitch_deg, r.flicker = pitch_deg, flicker
@@ -34,7 +37,10 @@ def ms_per_view(cls: type, camera, size: tuple[int, int], views: int, seed: int,
         world.robot.z_m = 1.9 - 1.2 * i / views
         world.robot.theta = 0.3 * math.sin(i / 20)
         world.t = i / 30
-        r.view(i % 2, True, (0.6 * math.sin(i / 7), 0.2), world.t)
+        if image:
+            r.image(i % 2, True, (0.6 * math.sin(i / 7), 0.2), world.t)
+        else:
+            r.view(i % 2, True, (0.6 * math.sin(i / 7), 0.2), world.t)
     return (time.process_time() - t0) / views * 1e3
 
 
@@ -52,13 +58,16 @@ def main() -> None:
           f"{args.views} views x {args.repeats}")
     for label, kw in [("faulty", {}), ("faulty + flicker", {"flicker": Flicker(0.2, 100, 0.01)}),
                       ("faulty + knock 1.5 deg", {"pitch_deg": 1.5})]:
-        old, new = [], []
+        old, new, image = [], [], []
         for _ in range(args.repeats):
             old.append(ms_per_view(renderer_oracle.Renderer, camera, size, args.views,
                                    args.seed, **kw))
             new.append(ms_per_view(Renderer, camera, size, args.views, args.seed, **kw))
+            image.append(ms_per_view(Renderer, camera, size, args.views, args.seed, **kw,
+                                     image=True))
         print(f"{label:24s} before {min(old):.3f} ms/view, now {min(new):.3f} ms/view, "
-              f"{min(old) / min(new):.2f}x")
+              f"{min(old) / min(new):.2f}x; image() {min(image):.3f} ms "
+              f"({min(old) / min(image):.2f}x)")
 
 
 if __name__ == "__main__":

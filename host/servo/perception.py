@@ -14,7 +14,6 @@ distance (lane_window, match_window, lane_obstacle).
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass
 
 import cv2
@@ -22,6 +21,7 @@ import numpy as np
 
 from host.camera.geometry import Geometry
 from host.errors import HostError
+from host.servo.pixel_median import nanmedian0
 from host.stereo.matcher import compute_disparity, numba_threads
 from host.stereo.params import MatcherParams
 
@@ -166,9 +166,8 @@ def nearest_object(disp: np.ndarray, min_area: int, step: float = 0.5,
 def median_map(disps: list[np.ndarray]) -> np.ndarray:
     """The per-pixel median of several disparity maps (px, NaN where every map has none)."""
     stack = np.stack(disps)
-    with np.errstate(all="ignore"), warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)  # pixels invalid in every map stay NaN
-        return np.asarray(np.nanmedian(stack, axis=0)) if len(disps) > 1 else stack[0]
+    # np.nanmedian(stack, axis=0) to the bit, compiled (pixels invalid in every map stay NaN)
+    return nanmedian0(stack) if len(disps) > 1 else stack[0]
 
 
 def reference_target(disps: list[np.ndarray], min_area: int) -> tuple[Target, Floor | None]:

@@ -142,6 +142,32 @@ def _lens_hit_box(bounds: LensBounds, mx: np.ndarray, my: np.ndarray,
     return None if got[0] < 0 else got
 
 
+# lens maps and their bounds by (geometry, size, k1), shared: a campaign's trials meet its
+# 16 cameras over and over, and each Renderer made its two maps anew (cv2.undistortPoints on
+# every pixel, ~5 ms a sensor at 320x240)
+_LENSES: dict[tuple[object, ...], tuple[tuple[np.ndarray, np.ndarray], LensBounds]] = {}
+_KEEP_LENSES = 64
+
+
+def _kept_lens(world: World, k1: float
+               ) -> tuple[tuple[np.ndarray, np.ndarray], LensBounds] | None:
+    """lens_maps(world, k1) and their _lens_bounds, made once a process for each geometry,
+    size and k1 (shared by the Renderers: nothing writes to them; left writeable, as numba's
+    kernels that read them were compiled for)."""
+    if not k1:
+        return None
+    key = (world.geometry, tuple(world.size), float(k1))
+    got = _LENSES.get(key)
+    if got is None:
+        maps = lens_maps(world, k1)
+        assert maps is not None
+        got = (maps, _lens_bounds(*maps))
+        if len(_LENSES) >= _KEEP_LENSES:
+            _LENSES.clear()
+        _LENSES[key] = got
+    return got
+
+
 class Renderer:
     def __init__(self, world: World, camera: CameraFaults = CameraFaults(), seed: int = 0,
                  grey: bool = False) -> None:
@@ -168,13 +194,17 @@ class Renderer:
         self._row0 = 0  # rows of the canvas above the view's first (a pitched rig sees them)
         self.flicker: Flicker | None = None
         self._touched: list[tuple[int, int, int, int]] = []  # rows, columns drawn this view
+        # drawing over the static views in place (image()): each rectangle's pixels as they were
+        # before it was drawn, put back after the view (None: drawing on copies, view())
+        self._undo: list[tuple[int, int, int, int, np.ndarray, np.ndarray | None]] | None = None
         # the last view as the bare scene's image (never written to) and the rows, columns
         # y0, y1, x0, x1 where it differs from it (None: nowhere); None: a whole new image
         self.changed: tuple[np.ndarray, tuple[int, int, int, int] | None] | None = None
         self._bare_key: tuple[object, ...] | None = None  # the layout _bare_images are of
         self._bare_images: dict[tuple[object, ...], np.ndarray] = {}
-        self._lens = [lens_maps(world, k1) for k1 in camera.distortion]
-        self._lens_bounds = [None if m is None else _lens_bounds(*m) for m in self._lens]
+        lenses = [_kept_lens(world, k1) for k1 in camera.distortion]
+        self._lens = [None if m is None else m[0] for m in lenses]
+        self._lens_bounds = [None if m is None else m[1] for m in lenses]
         w, h = world.size
         # sensor noise: a bank of independent fields, one drawn at random per view (drawing a
         # fresh field per view costs more than the rest of the rendering)
@@ -307,7 +337,7 @@ class Renderer:
             s = i / (2 * n) - 0.5
             k[int(round(n + s * blur_px[1])), int(round(n + s * blur_px[0]))] += 1.0
         k /= k.sum()
-        self._touched.append((r0, r1, c0, c1))
+        self._touch(image, None, r0, r1, c0, c1)
         region = image[r0:r1, c0:c1]
         region[:] = cv2.filter2D(region, -1, k, borderType=cv2.BORDER_REPLICATE)
 
@@ -321,7 +351,7 @@ class Renderer:
         r0, r1 = max(0, int(math.ceil(y0))), min(h, int(math.ceil(y1)))
         if c0 >= c1 or r0 >= r1:
             return
-        self._touched.append((r0, r1, c0, c1))
+        self._touch(image, disp, r0, r1, c0, c1)
         shown = ~(disp[r0:r1, c0:c1] > d + NEARER_PX)
         if texture is not None:  # the texture from its corner, repeated where the box is larger
             th, tw = texture.shape
@@ -343,7 +373,7 @@ class Renderer:
         r0, r1 = max(0, int(v - ry * ring) - 1), min(h, int(v + ry * ring) + 2)
         if c0 >= c1 or r0 >= r1:
             return
-        self._touched.append((r0, r1, c0, c1))
+        self._touch(image, disp, r0, r1, c0, c1)
         sub = (np.arange(4) + 0.5) / 4 - 0.5
         qy = ((np.arange(r0, r1)[:, None] + sub - v) / ry) ** 2  # rows x 4 sub-rows
         qx = ((np.arange(c0, c1)[:, None] + sub - u) / rx) ** 2  # columns x 4 sub-columns
@@ -364,36 +394,76 @@ class Renderer:
         or BGR), and the exact disparity of the ideal left view (side 0; NaN where none).
         t_s: when the capture began (the flicker's phase; default the world's time). People
         and other robots are part of the scene: drawn with or without the robot."""
+        return self._view(side, with_robot, blur_px, t_s, in_place=False)
+
+    def image(self, side: int, with_robot: bool = True,
+              blur_px: tuple[float, float] = (0.0, 0.0), t_s: float | None = None
+              ) -> np.ndarray:
+        """view()'s image alone, the same to the byte. Without a pitch or flicker the robots
+        and people are drawn over the static view itself and their rectangles put back after
+        (only the drawn rectangle is used from then on): no copy of the whole canvas and its
+        disparity each view."""
+        return self._view(side, with_robot, blur_px, t_s, in_place=True)[0]
+
+    def _touch(self, image: np.ndarray, disp: np.ndarray | None, r0: int, r1: int, c0: int,
+               c1: int) -> None:
+        """Rows r0:r1, columns c0:c1 are about to be drawn over (of image, and of disp unless
+        None): noted, and kept as they were when drawing in place."""
+        self._touched.append((r0, r1, c0, c1))
+        if self._undo is not None:
+            self._undo.append((r0, r1, c0, c1, image[r0:r1, c0:c1].copy(),
+                               None if disp is None else disp[r0:r1, c0:c1].copy()))
+
+    def _view(self, side: int, with_robot: bool, blur_px: tuple[float, float],
+              t_s: float | None, in_place: bool) -> tuple[np.ndarray, np.ndarray]:
         static = self._static_views()[side]
-        img, disp = (a.copy() for a in static)
+        in_place = in_place and not self.pitch_deg and self.flicker is None
+        img, disp = static if in_place else (static[0].copy(), static[1].copy())
         world = self.world
         self._row0 = (img.shape[0] - world.size[1]) // 2
         self._touched = []
+        self._undo = [] if in_place else None
         things: list[tuple[float, Person | Robot]] = [(p.z_m, p) for p in world.people]
         things += [(r.z_m, r) for r in world.decoys]
         if with_robot:
             things.append((world.robot.z_m, world.robot))
-        for _, thing in sorted(things, key=lambda zt: -zt[0]):  # far to near
-            if isinstance(thing, Person):
-                self._draw_person(img, disp, float(side), thing)
-            else:
-                blur = blur_px if thing is world.robot else (0.0, 0.0)
-                self._draw_robot(img, disp, float(side), blur, thing)
+        box: tuple[int, int, int, int] | None = None
+        try:
+            for _, thing in sorted(things, key=lambda zt: -zt[0]):  # far to near
+                if isinstance(thing, Person):
+                    self._draw_person(img, disp, float(side), thing)
+                else:
+                    blur = blur_px if thing is world.robot else (0.0, 0.0)
+                    self._draw_robot(img, disp, float(side), blur, thing)
+            if self._touched:  # one rectangle round them all: the drawings overlap
+                r0, r1, c0, c1 = (f(t[i] for t in self._touched)
+                                  for i, f in enumerate((min, max, min, max)))
+                box = (r0, r1, c0, c1)
+            # what was drawn there (a copy while the static view is drawn on: it is put back)
+            drawn = None if box is None else img[r0:r1, c0:c1]
+            if in_place and drawn is not None:
+                drawn = drawn.copy()
+        finally:
+            if self._undo is not None:
+                for y0, y1, x0, x1, kept_img, kept_disp in reversed(self._undo):
+                    img[y0:y1, x0:x1] = kept_img
+                    if kept_disp is not None:
+                        disp[y0:y1, x0:x1] = kept_disp
+                self._undo = None
         k = self._noise_field(side)
         self.changed = None
         if not self.pitch_deg and self.flicker is None and self._lens[side] is not None:
-            return self._through_lens(img, side, k), disp
+            return self._through_lens(drawn, box, side, k), disp
         if not self.pitch_deg and self.flicker is None and self._lens[side] is None:
             # each pixel's grey level is a function of the ideal view's there alone: the scene's
             # pixels come from the sensor's image of the bare scene with this noise field, and
             # only the pixels drawn over go through the sensor again
             out = self._bare(side, k).copy()
             self.changed = (self._bare(side, k), None)
-            if self._touched:  # one rectangle round them all: the drawings overlap
-                r0, r1, c0, c1 = (f(t[i] for t in self._touched)
-                                  for i, f in enumerate((min, max, min, max)))
-                out[r0:r1, c0:c1] = self._sensor(img[r0:r1, c0:c1], side, k, (r0, r1, c0, c1))
-                self.changed = (self._bare(side, k), (r0, r1, c0, c1))
+            if box is not None and drawn is not None:
+                r0, r1, c0, c1 = box
+                out[r0:r1, c0:c1] = self._sensor(drawn, side, k, box)
+                self.changed = (self._bare(side, k), box)
             return out, disp
         if self.pitch_deg:  # the canvas's rows seen through the pitched rig
             hom = rotation_homography(world, self.pitch_deg) @ np.array(
@@ -472,16 +542,18 @@ class Renderer:
         gains = np.asarray(self._white[side], np.float32)
         return img * gains[0] if self.grey else img[..., None] * gains
 
-    def _through_lens(self, img: np.ndarray, side: int, k: int | None) -> np.ndarray:
+    def _through_lens(self, drawn: np.ndarray | None, box: tuple[int, int, int, int] | None,
+                      side: int, k: int | None) -> np.ndarray:
         """_sensor(img) with a lens (no pitch, flicker), from the bare scene's image: remap()
         makes each pixel from its map's entry and the 2x2 source pixels there alone, so only
-        the pixels whose source meets the rectangle drawn over are remapped again."""
+        the pixels whose source meets the rectangle drawn over (box: rows r0:r1, columns
+        c0:c1, round everything drawn; drawn: the ideal view's pixels there) are remapped
+        again."""
         out = self._bare(side, k).copy()
         self.changed = (self._bare(side, k), None)
-        if not self._touched:
+        if box is None or drawn is None:
             return out
-        r0, r1, c0, c1 = (f(t[i] for t in self._touched)
-                          for i, f in enumerate((min, max, min, max)))
+        r0, r1, c0, c1 = box
         key = ("before lens", side, k)
         if key not in self._bare_images:
             self._bare_images[key] = self._before_lens(self._static[side][0], side, k)
@@ -501,7 +573,7 @@ class Renderer:
         # the drawn rectangle goes into the bare scene's image for the remap and is taken out
         # again: the same source as a copy with the rectangle in it, without copying the rest
         kept = src[r0:r1, c0:c1].copy()
-        src[r0:r1, c0:c1] = self._before_lens(img[r0:r1, c0:c1], side, k, (r0, r1, c0, c1))
+        src[r0:r1, c0:c1] = self._before_lens(drawn, side, k, (r0, r1, c0, c1))
         try:
             part = cv2.remap(src, mx[y0:y1, x0:x1], my[y0:y1, x0:x1], cv2.INTER_LINEAR,
                              borderMode=cv2.BORDER_REPLICATE)
@@ -533,6 +605,6 @@ class Renderer:
 
     def frame(self, with_robot: bool = True) -> StereoFrame:
         """Both views now, captured together (time: the world's)."""
-        left, _ = self.view(0, with_robot)
-        right, _ = self.view(1, with_robot)
+        left = self.image(0, with_robot)
+        right = self.image(1, with_robot)
         return StereoFrame(left, right, self.world.t, self.world.t)

@@ -148,37 +148,49 @@ class SimSource(StereoSource):
         outbound = emu._outbound
         applied, queued = self._applied, self._queued
         start = self.now_ms
-        for now in range(start, start + ms):
-            if now >= wake:
-                self.now_ms = now
-                self._apply_events()
-                wake = self._wake_ms()
-            motors = read_motors()
-            if motors != queued:
-                pending.append((now + latency, motors))
-                queued = motors
-            while pending and pending[0][0] <= now:
-                applied = pending.popleft()[1]
-            # World.step(dt, *applied)
-            w.t += dt
-            supply = max(0.5, 1.0 - f.sag_per_m * w.travelled_m)
-            duty_left, duty_right = applied
-            traction = w.traction
-            t_left = (wheel(duty_left, supply, gain[0], offset[0], traction[0])
-                      if duty_left else 0.0 * gain[0] * traction[0])
-            t_right = (wheel(duty_right, supply, gain[1], offset[1], traction[1])
-                       if duty_right else 0.0 * gain[1] * traction[1])
-            r.v_left += (t_left - r.v_left) * a
-            r.v_right += (t_right - r.v_right) * a
-            v = (r.v_left + r.v_right) / 2
-            r.theta += (r.v_left - r.v_right) / wheelbase * dt
-            r.x_m += (v * math.sin(r.theta) + push) * dt
-            r.z_m += v * math.cos(r.theta) * dt
-            w.travelled_m += abs(v) * dt
-            advance_1()
-            if until_tx and outbound and outbound[0][0] <= emu.now_ms:
-                ms = now + 1 - start
-                break
+        sag, sin, cos = f.sag_per_m, math.sin, math.cos
+        # the robot's state and the world's clock in locals between the scene's events (which
+        # read and move them: written back before, read again after), the same arithmetic
+        t, travelled, traction = w.t, w.travelled_m, w.traction
+        v_left, v_right, theta, x_m, z_m = r.v_left, r.v_right, r.theta, r.x_m, r.z_m
+        try:
+            for now in range(start, start + ms):
+                if now >= wake:
+                    self.now_ms = now
+                    w.t, w.travelled_m = t, travelled
+                    r.v_left, r.v_right, r.theta, r.x_m, r.z_m = v_left, v_right, theta, x_m, z_m
+                    self._apply_events()
+                    wake = self._wake_ms()
+                    t, travelled, traction = w.t, w.travelled_m, w.traction
+                    v_left, v_right, theta, x_m, z_m = r.v_left, r.v_right, r.theta, r.x_m, r.z_m
+                motors = read_motors()
+                if motors != queued:
+                    pending.append((now + latency, motors))
+                    queued = motors
+                while pending and pending[0][0] <= now:
+                    applied = pending.popleft()[1]
+                # World.step(dt, *applied)
+                t += dt
+                supply = max(0.5, 1.0 - sag * travelled)
+                duty_left, duty_right = applied
+                t_left = (wheel(duty_left, supply, gain[0], offset[0], traction[0])
+                          if duty_left else 0.0 * gain[0] * traction[0])
+                t_right = (wheel(duty_right, supply, gain[1], offset[1], traction[1])
+                           if duty_right else 0.0 * gain[1] * traction[1])
+                v_left += (t_left - v_left) * a
+                v_right += (t_right - v_right) * a
+                v = (v_left + v_right) / 2
+                theta += (v_left - v_right) / wheelbase * dt
+                x_m += (v * sin(theta) + push) * dt
+                z_m += v * cos(theta) * dt
+                travelled += abs(v) * dt
+                advance_1()
+                if until_tx and outbound and outbound[0][0] <= emu.now_ms:
+                    ms = now + 1 - start
+                    break
+        finally:
+            w.t, w.travelled_m = t, travelled
+            r.v_left, r.v_right, r.theta, r.x_m, r.z_m = v_left, v_right, theta, x_m, z_m
         self.now_ms = start + ms
         self._applied, self._queued = applied, queued
 
@@ -328,7 +340,7 @@ class SimSource(StereoSource):
         vel = self.renderer.image_velocity()
         blur = (vel[0] * self.renderer.camera.exposure_ms / 1000,
                 vel[1] * self.renderer.camera.exposure_ms / 1000)
-        image, _ = self.renderer.view(side, with_robot, blur, t_s=began)
+        image = self.renderer.image(side, with_robot, blur, t_s=began)
         self._held[side] = (image, stamp)
         self._made[side] = (image, self.renderer.changed)
         return image, stamp
