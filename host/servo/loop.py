@@ -97,6 +97,7 @@ from host.servo.recovery import (
     BackOff,
     BackOffConfig,
     Recovery,
+    lane_steer,
     servo_bounds,
 )
 from host.servo.recovery import OUTSIDE as OUTSIDE_KIND
@@ -1006,8 +1007,12 @@ class Servo:
             if fit is not None and not x0 <= lateral <= x1:
                 toward = -fit[2] if lateral > x1 else fit[2]
                 pushed = max(0.0, toward) * c.cfg.push_horizon_s
+        steer, lane, st = 0.0, c.lane(depth), self.estimator.state
+        if lateral is not None and lane is not None and st is not None and b.way is not None:
+            steer = lane_steer(b.way, lateral, lane, st.vx, c.cfg.steer_gain,
+                               c.cfg.steer_damping)
         left, right = b.update(t, depth, gap, c.target_m, self.tracker_confirmed, c.facing_away,
-                               c.trim, pushed, c.floor)
+                               c.trim, pushed, c.floor, steer)
         if b.outcome == DONE:
             rec.update(t, True)
             self.backoff = None

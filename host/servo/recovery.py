@@ -191,7 +191,8 @@ class BackOff:
     the lane watch looks that way too: a new object there within the stopping distance ends
     the back-off, named. Away from the camera the robot's own body hides a low object right
     behind it (perception.lane_obstacle sees only beside and above it): that way the travel
-    is bounded by block_m + clear_m from the object's depth (at most 0.25 m), no more."""
+    is bounded by block_m + clear_m from the object's depth (at most 0.25 m), no more. It
+    steers onto the lane the controller will hold (lane_steer)."""
 
     def __init__(self, block_m: float, cfg: BackOffConfig = BackOffConfig()) -> None:
         self.block_m, self.cfg = block_m, cfg
@@ -210,7 +211,7 @@ class BackOff:
 
     def update(self, t: float, z: float | None, gap: float | None, target_m: float,
                confirmed: bool, facing_away: bool, trim: float,
-               pushed_m: float = 0.0, floor: int = 0) -> tuple[int, int]:
+               pushed_m: float = 0.0, floor: int = 0, steer: float = 0.0) -> tuple[int, int]:
         """z: the robot's depth this frame at t (None: not seen, it stands; unseen unseen_s
         once it has moved, the back-off ends: the re-acquisition looks for the card, its
         spin checked as any); gap: the body's clearance across from the object's extent
@@ -223,7 +224,9 @@ class BackOff:
         and clear it: no safe way back (seed 14 trial 162: 1.9 cm closing at 0.9 cm/s, the
         re-measure not in 2.6 s). floor: the least duty that moves the robot now (the
         controller's, raised by stiction or a sagging battery): no wheel is driven below it,
-        so the back-off moves where the drive would."""
+        so the back-off moves where the drive would. steer: permille taken from the left
+        wheel and given to the right (lane_steer: the new lane's pull), at most half the
+        duty."""
         if z is not None:
             self.seen_t = t
         elif self.start_z is not None and self.seen_t is not None and \
@@ -282,11 +285,24 @@ class BackOff:
                 not self.deeper, True, z, gap
         sign = 1 if self.deeper == facing_away else -1
         d = sign * max(cfg.duty, floor)
-        left, right = d * (1 - trim), d * (1 + trim)
+        bend = max(-abs(d) / 2, min(abs(d) / 2, steer))
+        left, right = d * (1 - trim) - bend, d * (1 + trim) + bend
         lift = floor - min(abs(left), abs(right))  # no wheel below the least duty that moves
         if lift > 0:
             left, right = left + math.copysign(lift, d), right + math.copysign(lift, d)
         return int(round(left)), int(round(right))
+
+
+def lane_steer(way: int, lateral_m: float, lane_m: float, vx_mps: float, gain: float,
+               damping: float) -> float:
+    """The back-off's steer (permille, BackOff.update's steer): the controller's lane law
+    (its PD: gain permille per cm off the lane, damping per cm/s of sideways rate) in the
+    back-off's direction (way: +1 away from the camera, -1 toward it). Straight along a
+    heading turned toward the object's side, backing off carried the body across it (seed 14
+    trial 71: 17 degrees, 5 cm over 0.16 m of depth) and the new lane could not win it back
+    in the run-up (line through the object, the fourth time); bent onto the lane, the body
+    comes out of the object's depth clear of its side."""
+    return way * (gain * 100 * (lateral_m - lane_m) + damping * 100 * vx_mps) / 2
 
 
 def _nth(n: int) -> str:
