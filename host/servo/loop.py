@@ -97,6 +97,7 @@ from host.servo.recovery import (
     BackOff,
     BackOffConfig,
     Recovery,
+    lane_steer,
     servo_bounds,
 )
 from host.servo.recovery import OUTSIDE as OUTSIDE_KIND
@@ -611,16 +612,18 @@ class Servo:
 
     # ---------------------------------------------------------------------- the lane
 
-    def _lane_blocked(self, frame: StereoFrame, cmd: Command | None = None) -> str:
+    def _lane_blocked(self, frame: StereoFrame, cmd: Command | None = None,
+                      direction: int | None = None) -> str:
         """An object in the lane ahead of the robot within its stopping distance at its speed
         (and lane_margin_m), the way the control law will move it (toward the target's
-        depth), outside the robot's own image region: why the robot must stop, or "". Moving
-        away from the camera, what the robot hides is seen only beside or above it."""
+        depth; direction, +1 away from the camera or -1 toward it: that way instead, a
+        back-off's), outside the robot's own image region: why the robot must stop, or "".
+        Moving away from the camera, what the robot hides is seen only beside or above it."""
         est, c = self.estimator, self.controller
         if est.state is None or c is None or self.reference_map is None:
             return ""
         z, x = est.state.z, est.state.x
-        direction = 1 if z < c.target_m else -1
+        direction = direction or (1 if z < c.target_m else -1)
         # the faster of the command in force and the one to be sent (standing, the stretch
         # the next drive would need)
         duty = max(abs(c_.left + c_.right) / 2 for c_ in (self._cmd, cmd or self._cmd))
@@ -762,7 +765,10 @@ class Servo:
         if est.state is None or c is None:
             return ""
         z, x = est.state.z, est.state.x
-        toward = cmd.phase == Phase.PROBE or c.target_m < z
+        # the way it goes in depth: a back-off's own (recovery.BackOff.way), not the drive's
+        b = self.backoff
+        toward = (b.way < 0) if b is not None and b.way is not None else (
+            cmd.phase == Phase.PROBE or c.target_m < z)
         pair = self.last_pair
         if pair is not None:
             h, w = frame.left.shape[:2]
@@ -1002,8 +1008,12 @@ class Servo:
             if fit is not None and not x0 <= lateral <= x1:
                 toward = -fit[2] if lateral > x1 else fit[2]
                 pushed = max(0.0, toward) * c.cfg.push_horizon_s
+        steer, lane, st = 0.0, c.lane(depth), self.estimator.state
+        if lateral is not None and lane is not None and st is not None and b.way is not None:
+            steer = lane_steer(b.way, lateral, lane, st.vx, c.cfg.steer_gain,
+                               c.cfg.steer_damping)
         left, right = b.update(t, depth, gap, c.target_m, self.tracker_confirmed, c.facing_away,
-                               c.trim, pushed)
+                               c.trim, pushed, c.floor, steer)
         if b.outcome == DONE:
             rec.update(t, True)
             self.backoff = None
@@ -1284,9 +1294,16 @@ class Servo:
             self.stop_reason = self.stop_reason or fault
             self.controller.phase = Phase.STOP
             return Command(0, 0, Phase.STOP, cmd.error_m), invalid
-        # backing off (away from the target's depth) the lane ahead is not the way it goes
-        blocked = self._lane_blocked(frame, cmd) if moving and self.backoff is None else ""
-        rec = self.recovery
+        rec, b = self.recovery, self.backoff
+        if moving and b is not None and b.way is not None:  # the lane the way it backs off
+            ahead = self._lane_blocked(frame, cmd, b.way)
+            if ahead:  # nothing to wait in: the back-off's wait is on (recovery.py)
+                rec.give_up(f"no safe way back: {ahead} backing off")
+                self.backoff = None
+                self.stop_reason = self.stop_reason or rec.fault
+                self.controller.phase = Phase.STOP
+                return Command(0, 0, Phase.STOP, cmd.error_m), invalid
+        blocked = self._lane_blocked(frame, cmd) if moving and b is None else ""
         if blocked:
             if rec.kind == LANE:
                 rec.update(t, False)

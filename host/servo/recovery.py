@@ -187,8 +187,12 @@ class BackOff:
     update gives the wheels' duties; `outcome` is DONE (resume) or why there is no safe way
     back (the run ends, named), "" while under way. The loop's checks of a drive (the
     marker in view, the fixed objects, the motion against the command) act on the
-    back-off's commands as on any drive; the lane watch does not (it looks toward the
-    target, and the back-off goes the other way, within max_m)."""
+    back-off's commands as on any drive, the view's the way the back-off goes (`way`), and
+    the lane watch looks that way too: a new object there within the stopping distance ends
+    the back-off, named. Away from the camera the robot's own body hides a low object right
+    behind it (perception.lane_obstacle sees only beside and above it): that way the travel
+    is bounded by block_m + clear_m from the object's depth (at most 0.25 m), no more. It
+    steers onto the lane the controller will hold (lane_steer)."""
 
     def __init__(self, block_m: float, cfg: BackOffConfig = BackOffConfig()) -> None:
         self.block_m, self.cfg = block_m, cfg
@@ -199,9 +203,15 @@ class BackOff:
         self.flipped = False
         self.seen_t: float | None = None  # the card last seen
 
+    @property
+    def way(self) -> int | None:
+        """The way it backs off in depth: +1 away from the camera, -1 toward it, None
+        before its first move is decided (the lane watch looks this way: loop.py)."""
+        return None if self.deeper is None else 1 if self.deeper else -1
+
     def update(self, t: float, z: float | None, gap: float | None, target_m: float,
                confirmed: bool, facing_away: bool, trim: float,
-               pushed_m: float = 0.0) -> tuple[int, int]:
+               pushed_m: float = 0.0, floor: int = 0, steer: float = 0.0) -> tuple[int, int]:
         """z: the robot's depth this frame at t (None: not seen, it stands; unseen unseen_s
         once it has moved, the back-off ends: the re-acquisition looks for the card, its
         spin checked as any); gap: the body's clearance across from the object's extent
@@ -212,7 +222,11 @@ class BackOff:
         or the body across the object's extent). Standing for the re-measure with a gap
         below it, the push would bring the body onto the side before a back-off could begin
         and clear it: no safe way back (seed 14 trial 162: 1.9 cm closing at 0.9 cm/s, the
-        re-measure not in 2.6 s)."""
+        re-measure not in 2.6 s). floor: the least duty that moves the robot now (the
+        controller's, raised by stiction or a sagging battery): no wheel is driven below it,
+        so the back-off moves where the drive would. steer: permille taken from the left
+        wheel and given to the right (lane_steer: the new lane's pull), at most half the
+        duty."""
         if z is not None:
             self.seen_t = t
         elif self.start_z is not None and self.seen_t is not None and \
@@ -237,22 +251,29 @@ class BackOff:
         # per metre of depth travelled)
         shrunk = 0.0 if gap is None or self.start_gap is None else self.start_gap - gap
         closing = shrunk > max(cfg.turn_m, cfg.turned * abs(z - self.start_z))
-        # level with the object's face (within level_m of its depth) the body's side can
-        # reach the object's; off it, across the object's extent is only its line, and the
-        # way away from the face is the one way back (the other way is into the face)
+        # level with the object's face (within level_m of its depth) or behind it, the
+        # body's side can reach the object's: a real object's sides run back from its face
+        # for a depth the camera does not see (the simulation's box is its face alone; the
+        # reference's fixed cells are faces too). In front of the face, across the object's
+        # extent is only its line, and the way away from the face is the one way back (the
+        # other way is into the face)
         level = abs(e) < cfg.level_m
+        beside = e > -cfg.level_m
         tight = gap is not None and gap < cfg.side_m
-        if level and closing and (self.flipped or tight):
+        if beside and closing and (self.flipped or tight):
             self.outcome = ("no safe way back: backing off either way closes on its side"
                             if self.flipped else
                             "no safe way back: backing off closes on the object's side")
-        elif (level or e > 0) and gap is not None and gap < 0 <= (self.start_gap or 0.0):
-            # beyond the face the body coming across the object's extent goes behind it:
-            # where a box's own depth is, which the face hides from the camera, where an
-            # object pushed farther lands (seed 14 trial 609), and no lane watch looks there
-            self.outcome = ("no safe way back: the body is at the object's side" if level else
-                            "no safe way back: backing off takes the body behind the "
-                            "object's face")
+        elif e > 0 and gap is not None and gap < 0:
+            # behind the face, across the object's extent: where a box's own depth is, which
+            # the face hides from the camera, where an object pushed farther lands (seed 14
+            # trial 609); no way there keeps out of it, whichever way the body came
+            self.outcome = ("no safe way back: backing off takes the body behind the "
+                            "object's face" if (self.start_gap or 0.0) >= 0 else
+                            "no safe way back: the body is behind the object's face, "
+                            "across its extent")
+        elif level and gap is not None and gap < 0 <= (self.start_gap or 0.0):
+            self.outcome = "no safe way back: the body is at the object's side"
         elif abs(z - self.start_z) > cfg.max_m:
             self.outcome = f"no safe way back: {cfg.max_m:.2f} m backed off and still beside it"
         elif not self.deeper and z < cfg.camera_m:
@@ -263,8 +284,25 @@ class BackOff:
             self.deeper, self.flipped, self.start_z, self.start_gap = \
                 not self.deeper, True, z, gap
         sign = 1 if self.deeper == facing_away else -1
-        d = sign * cfg.duty
-        return int(round(d * (1 - trim))), int(round(d * (1 + trim)))
+        d = sign * max(cfg.duty, floor)
+        bend = max(-abs(d) / 2, min(abs(d) / 2, steer))
+        left, right = d * (1 - trim) - bend, d * (1 + trim) + bend
+        lift = floor - min(abs(left), abs(right))  # no wheel below the least duty that moves
+        if lift > 0:
+            left, right = left + math.copysign(lift, d), right + math.copysign(lift, d)
+        return int(round(left)), int(round(right))
+
+
+def lane_steer(way: int, lateral_m: float, lane_m: float, vx_mps: float, gain: float,
+               damping: float) -> float:
+    """The back-off's steer (permille, BackOff.update's steer): the controller's lane law
+    (its PD: gain permille per cm off the lane, damping per cm/s of sideways rate) in the
+    back-off's direction (way: +1 away from the camera, -1 toward it). Straight along a
+    heading turned toward the object's side, backing off carried the body across it (seed 14
+    trial 71: 17 degrees, 5 cm over 0.16 m of depth) and the new lane could not win it back
+    in the run-up (line through the object, the fourth time); bent onto the lane, the body
+    comes out of the object's depth clear of its side."""
+    return way * (gain * 100 * (lateral_m - lane_m) + damping * 100 * vx_mps) / 2
 
 
 def _nth(n: int) -> str:
