@@ -41,7 +41,7 @@ from host.stereo.matcher import SERIAL_WORK, warm_up
 STAGES = {  # what the loop calls, by the name the table prints
     "exposure": (loop, "match_exposure"),
     "marker": (loop, "marker_candidates"),
-    "marker window match": (loop.Servo, "_robot_disparity"),
+    "marker window match": (loop, "marker_disparity"),
     "re-measure band": (StripMap, "add"),
     "re-measure analysis": (loop.Servo, "_remeasure"),
     "control law": (loop.Controller, "update"),
