@@ -129,15 +129,15 @@ def box_sum(raw, box):
 
 
 PAD = np.uint16(0x3FFF)  # path cost beyond the disparity range: never the minimum
-ROW_LANES = 32  # the 4-path pass's cost rows hold a multiple of this many candidates
+ROW_LANES = 16  # the 4-path pass's cost rows hold a multiple of this many candidates
 
 
 @njit(cache=True, inline="always")
 def padded(nd):
     """nd rounded up to a multiple of ROW_LANES: the width of the 4-path pass's cost rows and
-    of the reversed right rows and planes (_cost_row), so the cost loops run whole vectors of
-    the 32 lanes LLVM gives them, never a scalar remainder (640x480 took longer at 56
-    candidates than at 64)."""
+    of the reversed right rows and planes (_cost_row), so the cost loops run over a multiple
+    of 16 lanes, not into a scalar remainder: 640x480 took longer at 56 candidates than at 64.
+    (Padded to 32, 640x480/48 took 1.05-1.13x the unpadded time, load 15-17.)"""
     return (nd + ROW_LANES - 1) // ROW_LANES * ROW_LANES
 
 
@@ -182,22 +182,21 @@ def _cost_row(cl, crrev, gl, gr, vol, pl, prrev, term, y, dmin, crow, cs):
     # loops in one x loop the defaults' row took 13.4 ms a 640x480/64 image, alone 7 ms
     if ch == 0:
         for x in range(w):
-            _hamming(lrow, rrev, x, dmin, crow[x, :nd], far, False)
+            _hamming(lrow, rrev, x, dmin, crow[x], nd, far, False)
     elif narrow:
         for x in range(w):
             _term_row3(pl, prrev, y, x, w - 1 - x + dmin, crow[x], nd, kcap, ta, tb)
-            _hamming(lrow, rrev, x, dmin, crow[x, :nd], far, True)
+            _hamming(lrow, rrev, x, dmin, crow[x], nd, far, True)
     else:
         for x in range(w):
             _term_row(pl, prrev, y, x, w - 1 - x + dmin, crow[x], nd, kcap, term)
-            _hamming(lrow, rrev, x, dmin, crow[x, :nd], far, True)
+            _hamming(lrow, rrev, x, dmin, crow[x], nd, far, True)
 
 
 @njit(cache=True, fastmath=True, inline="always")
-def _hamming(lrow, rrev, x, dmin, c, far, add):
-    """The census Hamming distances of left pixel x's candidates into c (added to it: add),
+def _hamming(lrow, rrev, x, dmin, c, nd, far, add):
+    """The census Hamming distances of left pixel x's nd candidates into c (added to it: add),
     far where the right pixel is outside the image (see _cost_row)."""
-    nd = c.shape[0]
     a = lrow[x]
     base = lrow.shape[0] - 1 - x + dmin
     r = rrev[base:base + nd]
