@@ -25,7 +25,7 @@ import cv2
 import numpy as np
 from numba import njit, prange
 
-from host.stereo.sgm import CENSUS_BITS, NARROW_SHIFT, _popcount
+from host.stereo.sgm import CENSUS_BITS, NARROW_SHIFT, _popcount, padded
 
 
 @njit(cache=True, parallel=True)
@@ -92,10 +92,11 @@ def integer_term(ch: int, weight: float, cap: int, outside: int) -> np.ndarray |
 
 
 def reversed_planes(planes: np.ndarray, dmin: int, nd: int) -> np.ndarray:
-    """(channels, rows, cols) uint8 with each row reversed and dmin + nd zeros after it, the
-    layout of sgm.reversed_right, so _cost_row reads candidate j of x at w - 1 - x + dmin + j."""
+    """(channels, rows, cols) uint8 with each row reversed and dmin + sgm.padded(nd) zeros
+    after it, the layout of sgm.reversed_right, so _cost_row reads candidate j of x at w - 1 -
+    x + dmin + j (and the padded lanes past the candidates)."""
     c, h, w = planes.shape
-    out = np.zeros((c, h, w + dmin + nd), dtype=np.uint8)
+    out = np.zeros((c, h, w + dmin + padded(nd)), dtype=np.uint8)
     out[:, :, :w] = planes[:, :, ::-1]
     return out
 
