@@ -15,7 +15,7 @@ import pytest
 from host.servo.recovery import DONE, BackOff, BackOffConfig
 from host.sim.faults import MotorFaults, WorldFaults
 from host.sim.run import Setup, simulation
-from host.sim.trials import _unsafe
+from tests.servo.judged import Judged
 
 BOX = (-0.50, -0.18)  # the object's lateral extent (m): the default scene's nearest box
 HALF_WIDTH = 0.08
@@ -118,13 +118,9 @@ def test_in_closed_loop_a_robot_pushed_while_it_holds_backs_off_and_holds_again(
     never touching the object (the trials' judge)."""
     faults = WorldFaults(motor=MotorFaults(push_mps=-0.008))
     with simulation(Setup(start_z_m=1.25, start_x_m=-0.04, faults=faults, seed=3)) as sim:
-        servo, last_valid, outcome = sim.servo, sim.source.t, "unsettled"
+        servo, judged, outcome = sim.servo, Judged(sim), "unsettled"
         while sim.source.t < 30.0:
-            sim.step()
-            row = servo.rows[-1]
-            if math.isfinite(row.depth_m) and not row.reason:
-                last_valid = row.t
-            why = _unsafe(sim, last_valid, servo.stale_s)
+            why = judged.step()
             assert not why, why
             if servo.stop_reason:
                 outcome = servo.stop_reason

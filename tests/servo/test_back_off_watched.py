@@ -25,7 +25,7 @@ from host.servo.phase import Phase
 from host.servo.recovery import DONE, BackOff
 from host.sim.faults import Event, MotorFaults, WorldFaults
 from host.sim.run import Setup, simulation
-from host.sim.trials import _unsafe
+from tests.servo.judged import Judged
 
 BOX = (-0.50, -0.18)  # the default scene's target box, lateral extent (m)
 HALF_WIDTH = 0.08  # controller.ControlConfig.half_width_m
@@ -147,13 +147,9 @@ def test_an_object_put_down_in_the_back_offs_way_stops_it_named() -> None:
     faults = WorldFaults(motor=MotorFaults(push_mps=-0.008),
                          events=(Event(2.6, "appear", box=(1.0, -0.21, 0.09, 0.12)),))
     with simulation(Setup(start_z_m=1.25, start_x_m=-0.04, faults=faults, seed=3)) as sim:
-        servo, last_valid = sim.servo, sim.source.t
+        servo, judged = sim.servo, Judged(sim)
         while sim.source.t < 12.0 and not servo.stop_reason:
-            sim.step()
-            row = servo.rows[-1]
-            if math.isfinite(row.depth_m) and not row.reason:
-                last_valid = row.t
-            why = _unsafe(sim, last_valid, servo.stale_s)
+            why = judged.step()
             assert not why, why
         assert "no safe way back: an object in the lane" in servo.stop_reason
         assert "backing off" in servo.stop_reason

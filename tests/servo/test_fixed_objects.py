@@ -12,24 +12,20 @@ import math
 
 from host.sim.faults import Event, MotorFaults, WorldFaults
 from host.sim.run import Setup, simulation
-from host.sim.trials import _unsafe
+from tests.servo.judged import Judged
 
 
 def _run(setup: Setup, seconds: float) -> tuple[str, str, float]:
     """("unsafe", why) as the trials judge it, ("held", "") or ("stopped", reason); and the
     closest the robot's body came to the box at 1.8 m (m, side to side; negative: inside)."""
     with simulation(setup) as sim:
-        servo, last_valid, gap = sim.servo, sim.source.t, math.inf
+        servo, judged, gap = sim.servo, Judged(sim), math.inf
         box = sim.world.boxes[1]
         while sim.source.t < seconds:
-            sim.step()
-            row = servo.rows[-1]
-            if math.isfinite(row.depth_m) and not row.reason:
-                last_valid = row.t
+            why = judged.step()
             r = sim.world.robot
             if abs(r.z_m - box.z_m) < 0.06:
                 gap = min(gap, box.x0_m - (r.x_m + r.body_width_m / 2))
-            why = _unsafe(sim, last_valid, servo.stale_s)
             if why:
                 return "unsafe", why, gap
             if servo.stop_reason:
