@@ -168,6 +168,11 @@ class BackOffConfig:
     level_m: float = 0.12  # level with the face: the body's half diagonal (0.113) reaches it
     unseen_s: float = 1.0  # the card unseen this long backing off (turned away): re-acquired
     beyond_m: float = 0.02  # the robot this far beyond the object's face backs off deeper
+    corner_m: float = 0.033  # the body's half diagonal less its half width (0.113 - 0.08):
+    # how far a corner of a body turned any way reaches beyond the side the gap is reckoned
+    # for. Level with the face, closing, the other way runs the body past the object's end:
+    # with a gap below this it stops (seed 15 trial 857: gap 1.0 cm reckoned, the heading
+    # 2.5 degrees estimated, 23.5 true: the turned corner hit the side going deeper)
 
 
 DONE = "done"
@@ -260,7 +265,8 @@ class BackOff:
         level = abs(e) < cfg.level_m
         beside = e > -cfg.level_m
         tight = gap is not None and gap < cfg.side_m
-        if beside and closing and (self.flipped or tight):
+        near = gap is not None and gap < cfg.corner_m  # too near to pass the end turned
+        if beside and closing and (self.flipped or near):
             self.outcome = ("no safe way back: backing off either way closes on its side"
                             if self.flipped else
                             "no safe way back: backing off closes on the object's side")
