@@ -38,8 +38,10 @@ way the robot faces by what a short probe move does (a pure state machine, one c
              drove the unseen robot onto ground nobody had checked: the reviewer's "blind
              second leg"); refused by a fixed object on its first leg, the facing unshown
              (refused, from the servo), a spin test: spin_s one way at search_duty and as
-             long back, the card narrowing by spin_drop: the robot's, the run stops as
-             before; not: a look-alike, NOT_MOVED (the servo looks for another)
+             long back, the card's ratio changing by spin_drop/2 either way (narrower, or
+             wider: turned toward square): the robot's, the run stops as before; the same
+             through the turn: a look-alike, NOT_MOVED (the servo looks for another); stood
+             in it (a stale frame): its clock stops meanwhile, and the refusal stands
     a find that fails in a re-acquisition (again: why) says so: "not found again", not
     "never seen"
 """
@@ -142,6 +144,8 @@ class Acquisition:
         self._spun = False  # the test ran (once an acquisition)
         self._spin_t0: float | None = None
         self._turned: list[float] = []  # the card's ratios while the robot turns
+        self._spin_stood: float | None = None  # the spin test interrupted at (standing since)
+        self._spin_cut = False  # the spin test was interrupted: it shows no look-alike
         self.spent_s = spent_s  # the probe's driving before its last start (s)
 
     @property
@@ -217,6 +221,9 @@ class Acquisition:
         cfg = self.cfg
         if self._spin_t0 is None:
             self._spin_t0 = t
+        if self._spin_stood is not None:  # stood since (interrupted): the turn's clock stops
+            self._spin_t0 += t - self._spin_stood  # for the stand (the turn on in the stop's
+            self._spin_stood = None  # reaction, ~0.15-0.2 s in the sim, is not counted)
         el = t - self._spin_t0
         if el > cfg.run_down_s:
             self._turned.append(math.nan if aspect is None else aspect)
@@ -236,9 +243,16 @@ class Acquisition:
             # its standing ratio too noisy for the turn to show (far: seed 14's 221 at 3 m,
             # 0.04 a frame, narrowed 0.11 in a 30-degree turn): no look-alike is shown
             return Order(0, 0, Phase.PROBE)
+        if self._spin_cut:  # stood in the turn (a stale or frozen frame): no look-alike shown
+            return Order(0, 0, Phase.PROBE)
         runs = np.convolve(np.sort(seen), np.ones(3) / 3, mode="valid")
-        drop = base - float(runs[0])  # the three narrowest, against the standing ratio
-        if drop < cfg.spin_drop / 2:  # it stayed as it stood: not the robot's card
+        # the three narrowest or the three widest against the standing ratio: a change either
+        # way is the card turning with the robot (a robot found by the spin stands ~35-40
+        # degrees off square, and the test's first turn, the find spin's way, turns its card
+        # toward square: wider, never narrower; the reviewer's starts at -20 to -35 degrees
+        # were called look-alikes)
+        moved = max(base - float(runs[0]), float(runs[-1]) - base)
+        if moved < cfg.spin_drop / 2:  # it stayed as it stood: not the robot's card
             self.fault = NOT_MOVED
         return Order(0, 0, Phase.PROBE)
 
@@ -254,6 +268,18 @@ class Acquisition:
         saw so far is dropped and the phase begins again at the next usable frame (the robot
         stands meanwhile). A probe timed across a frozen sensor would find that the marker did
         not move, and leave the true marker out as a look-alike."""
+        if self.phase == Phase.PROBE and self._spin_why:
+            # in the spin test: the robot stands, so the turn's clock stops meanwhile (timed
+            # on, it ended the turn out early and the robot stood 30 degrees turned: the
+            # reviewer's 0.7 s stale), and what the card showed is dropped: the test turns
+            # back as far as it went and its refusal stands (a frozen frame's card stays the
+            # same, as a look-alike's would)
+            if self._spin_t0 is not None:  # begun (else it begins at the next usable frame)
+                if self._spin_stood is None:
+                    self._spin_stood = t
+                self._turned.clear()
+                self._spin_cut = True
+            return
         if self.phase in (Phase.MEASURE, Phase.PROBE):
             self.spent_s = self.driven_s()  # its travel stays (the evidence does not)
             if self.phase == Phase.MEASURE:

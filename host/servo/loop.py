@@ -694,7 +694,8 @@ class Servo:
             return ""
         fixed = self._fixed_fault(t, cmd)
         s = est.state
-        spin = not cmd.is_stop and cmd.phase in (Phase.FIND, Phase.SEARCH)
+        spin = not cmd.is_stop and (cmd.phase in (Phase.FIND, Phase.SEARCH) or cmd.phase
+                                    == Phase.PROBE and cmd.left * cmd.right < 0)  # spin test
         # the object's depth older than target_age_s (no re-measure while spinning): it may
         # have moved beside the robot unseen, so the spin must clear its extent at any depth
         aged = self._measured_t is not None and t - self._measured_t > self.cfg.target_age_s
@@ -1322,6 +1323,8 @@ class Servo:
             # standing checks still watch it: a drift onto a fixed object or the object)
             cmd, invalid = Command(0, 0, Phase.WAIT, cmd.error_m), invalid or stand
         fault = self._path_fault(frame, cmd) if moving else self._spin_fault(frame.t_left, cmd)
+        if moving and cmd.left * cmd.right < 0:  # the probe's spin test: a spin, checked as
+            fault = fault or self._spin_fault(frame.t_left, cmd)  # one (sweeps, aged depth)
         if fault.startswith(INTO_FIXED.format("probe")) and self.acquisition.refused(fault):
             return Command(0, 0, Phase.PROBE, cmd.error_m), invalid  # a spin test first
         if fault:  # nothing to wait for: the run ends here
