@@ -59,7 +59,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--flash", type=Path, metavar="FILE",
                    help="--robot uno: the board's flash, as `host emulate --uno --flash FILE` "
                         f"and an upload left it (default {UNO_FLASH})")
-    p.add_argument("--log", type=Path, metavar="run.csv", help="write the run's log")
+    p.add_argument("--log", type=Path, metavar="run.csv",
+                   help="write the run's log (with --trials: of the one --trial-index)")
     p.add_argument("--plot", type=Path, metavar="run.png",
                    help="plot trajectory and commands (with --trials: the campaign's summary)")
     p.add_argument("--duration", type=POSITIVE, metavar="S", help="stop after S seconds")
@@ -154,9 +155,9 @@ def run(args: argparse.Namespace) -> int:
     if args.robot != "emulator" and not args.sim:
         raise HostError(f"--robot {args.robot} puts a simulated board in the simulated world: "
                         f"it needs --sim")
-    if args.log and args.trials:
-        raise HostError("--log writes one run's log: not with --trials (a row a trial goes to "
-                        "--csv, every trial to --json)")
+    if args.log and args.trials and len(args.trial_index or ()) != 1:
+        raise HostError("--log writes one run's log: with --trials, give one --trial-index to "
+                        "trace that trial (a row a trial goes to --csv, every trial to --json)")
     if args.log:
         check_output(args.log, "csv", "--log")
     if args.plot:
@@ -245,9 +246,19 @@ def _run_sim(args: argparse.Namespace) -> int:
         from host.sim.campaign import run_trials
 
         ray = None if args.ray is None else True if args.ray == "local" else args.ray
-        return run_trials(args.trials, args.seed, parse_size(args.size), params, args.json,
-                          workers=args.workers, nominal=args.nominal, indices=args.trial_index,
-                          csv_path=args.csv, ray=ray, resume=args.resume, plot_path=args.plot)
+        status = run_trials(args.trials, args.seed, parse_size(args.size), params, args.json,
+                            workers=args.workers, nominal=args.nominal,
+                            indices=args.trial_index, csv_path=args.csv, ray=ray,
+                            resume=args.resume, plot_path=args.plot)
+        if args.log:  # the one trial again in this process, for its log: the same run
+            from host.sim.trials import traced_trial
+
+            _, rows = traced_trial((args.seed, args.trial_index[0], parse_size(args.size),
+                                    params, args.nominal))
+            with signals_held():
+                write_csv(args.log, rows)
+            print(f"log: {args.log}")
+        return status
     faults = WorldFaults()
     if args.faults:
         faults = random_faults(np.random.default_rng(args.seed), 1.2)

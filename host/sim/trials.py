@@ -233,6 +233,14 @@ class Judge:
 
 
 def run_trial(job: tuple[int, int, tuple[int, int], MatcherParams, bool]) -> Trial:
+    """One trial of a campaign, as its record (the workers' and Ray's task)."""
+    return traced_trial(job)[0]
+
+
+def traced_trial(job: tuple[int, int, tuple[int, int], MatcherParams, bool]
+                 ) -> tuple[Trial, list[LogRow]]:
+    """One trial, (seed, index, size, params, nominal), as its record and the servo's log
+    rows (a trial traced alone: `host servo --sim --trials N --trial-index I --log run.csv`)."""
     seed, index, size, params, nominal = job
     setup = trial_setup(seed, index, size, params, nominal)
     target0 = setup.boxes[0].z_m if setup.boxes else math.nan
@@ -275,4 +283,4 @@ def run_trial(job: tuple[int, int, tuple[int, int], MatcherParams, bool]) -> Tri
             t_hold = rows[k].t - rows[0].t
         return Trial(index, setup.start_z_m, target0, _describe(setup.faults),
                      event_kinds(setup.faults), outcome, reason, err, tol, max(0.0, over),
-                     t_hold, sim.source.t, judge.worst_gap)
+                     t_hold, sim.source.t, judge.worst_gap), servo.rows
