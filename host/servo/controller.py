@@ -62,6 +62,24 @@ TURN_BLOCKED = "turning here would sweep the robot's body into the object"
 INTO_FIXED = "the robot's {} would run into a fixed object that is not the target"
 
 
+def lane_pd(way: float, drift_m: float, xdot_mps: float, gain: float, damping: float,
+            share: float = 1.0) -> float:
+    """The lane law's steer (permille taken from the left wheel and given to the right): a PD
+    on the body's offset from its lane (drift_m; gain permille a cm, share of that pull) and
+    its sideways rate (xdot_mps; damping permille per cm/s), for a robot moving in depth the
+    way way says (+1 away from the camera, -1 toward it)."""
+    return way * (share * gain * 100 * drift_m + damping * 100 * xdot_mps) / 2
+
+
+def lifted(left: float, right: float, floor: float, sign: float) -> tuple[float, float]:
+    """The duties raised, both by the same amount in the direction sign (the arc kept), so
+    that neither wheel is below floor, the least duty that moves the robot."""
+    lift = floor - min(abs(left), abs(right))
+    if lift > 0:
+        return left + math.copysign(lift, sign), right + math.copysign(lift, sign)
+    return left, right
+
+
 @dataclass(frozen=True)
 class ControlConfig:
     tolerance_m: float = 0.01
@@ -433,8 +451,7 @@ class Controller:
             # fit's half second; the aspect is this frame's)
             off = math.degrees(math.acos(min(1.0, obs.aspect)))
             share = min(1.0, 2.0 - 2.0 * off / cfg.square_deg) if drift * xdot < 0 else 1.0
-            pull = max(0.0, share) * cfg.steer_gain * 100 * drift
-            pd = s * (pull + cfg.steer_damping * 100 * xdot) / 2
+            pd = lane_pd(s, drift, xdot, cfg.steer_gain, cfg.steer_damping, max(0.0, share))
             # creeping (the last few cm) the drift rate is mostly a sideways push, not heading:
             # steering against it turns the robot off the card's visible range and, near the
             # dead zone, spins it in place; only the wheels' trim acts there
@@ -444,9 +461,7 @@ class Controller:
         left, right = duty - steer, duty + steer
         if obs.lateral_m is not None and self._near_end(z, obs.lateral_m, left, right):
             left, right = self._by_the_end(z, obs.lateral_m, left, right)
-        lift = self.floor - min(abs(left), abs(right))  # no wheel below the least duty that moves
-        if lift > 0:
-            left, right = left + math.copysign(lift, duty), right + math.copysign(lift, duty)
+        left, right = lifted(left, right, self.floor, duty)  # no wheel below the floor
         return Command(int(round(left)), int(round(right)), self.phase, e)
 
     def _by_the_end(self, z: float, x: float, left: float, right: float
@@ -465,11 +480,7 @@ class Controller:
         best: tuple[float, float] | None = None
         far = -1.0
         for st in (steer, 0.0, abs(d) / 4, -abs(d) / 4, abs(d) / 2, -abs(d) / 2):
-            lo = d - st
-            hi = d + st
-            lift = self.floor - min(abs(lo), abs(hi))
-            if lift > 0:
-                lo, hi = lo + math.copysign(lift, d), hi + math.copysign(lift, d)
+            lo, hi = lifted(d - st, d + st, self.floor, d)
             hit = self._end_hit(z, x, lo, hi)
             if hit is None:
                 return lo, hi

@@ -44,6 +44,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from host.servo.controller import lane_pd, lifted
+
 MOVED, RESET, LANE, STALE, OUTSIDE, TARGET, LOST, BESIDE = "moved", "reset", "lane", \
     "stale", "outside", "target", "lost", "beside"
 WAIT, RESUME, GIVE_UP = "wait", "resume", "give up"
@@ -297,10 +299,7 @@ class BackOff:
         # the face, gap 1.2 cm, a lane 25 cm out: a corner behind the face 0.3 cm across the
         # side; tests/servo/test_back_off_steered.py); the lane is won in the run-up in front
         bend = 0.0 if beside else max(-abs(d) / 2, min(abs(d) / 2, steer))
-        left, right = d * (1 - trim) - bend, d * (1 + trim) + bend
-        lift = floor - min(abs(left), abs(right))  # no wheel below the least duty that moves
-        if lift > 0:
-            left, right = left + math.copysign(lift, d), right + math.copysign(lift, d)
+        left, right = lifted(d * (1 - trim) - bend, d * (1 + trim) + bend, floor, d)
         return int(round(left)), int(round(right))
 
 
@@ -313,7 +312,7 @@ def lane_steer(way: int, lateral_m: float, lane_m: float, vx_mps: float, gain: f
     trial 71: 17 degrees, 5 cm over 0.16 m of depth) and the new lane could not win it back
     in the run-up (line through the object, the fourth time); bent onto the lane, the body
     comes out of the object's depth clear of its side."""
-    return way * (gain * 100 * (lateral_m - lane_m) + damping * 100 * vx_mps) / 2
+    return lane_pd(way, lateral_m - lane_m, vx_mps, gain, damping)
 
 
 def _nth(n: int) -> str:
