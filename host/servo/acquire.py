@@ -375,7 +375,8 @@ class Acquisition:
                                              and not self._within_noise(noise_m)):
             self.fault = NOT_MOVED  # nothing moved by then: not the robot's marker
             return Order(0, 0, Phase.PROBE)
-        if self._leg == 2 and self._still and not self._shown_so_far(dz, noise_m) \
+        shown = self._shown_so_far(dz, noise_m)
+        if self._leg == 2 and self._still and not shown \
                 and self._at_start() and moved < cfg.still_factor * cfg.probe_m:
             # back at the start after a first leg whose sightings showed no move: beyond it
             # only on a move back that shows the sighting going with the robot (the reviewer's
@@ -390,8 +391,7 @@ class Acquisition:
         # (_shown): at 3 m sightings err together by 7-8 cm for frames on end, a move of a
         # few cm there shows nothing (seed 12 #246 took such a jump for its move, "faces the
         # camera", and drove toward the wall behind it)
-        if len(self._track) >= 10 and self._shown(
-                dz, self._track[-1][1], float(np.median(self._disp[-5:])), noise_m):
+        if shown:
             self.facing_away = (dz > 0) == (self.direction > 0)
             self._begin(Phase.DONE, t)
             return Order(0, 0, Phase.PROBE)
