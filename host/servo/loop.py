@@ -1327,19 +1327,17 @@ class Servo:
             fault = fault or self._spin_fault(frame.t_left, cmd)  # one (sweeps, aged depth)
         if fault.startswith(INTO_FIXED.format("probe")) and self.acquisition.refused(fault):
             return Command(0, 0, Phase.PROBE, cmd.error_m), invalid  # a spin test first
+        rec, b = self.recovery, self.backoff
+        if not fault and moving and b is not None and b.way is not None:
+            ahead = self._lane_blocked(frame, cmd, b.way)  # the lane the way it backs off
+            if ahead:  # nothing to wait in: the back-off's wait is on (recovery.py)
+                rec.give_up(f"no safe way back: {ahead} backing off")
+                self.backoff = None
+                fault = rec.fault
         if fault:  # nothing to wait for: the run ends here
             self.stop_reason = self.stop_reason or fault
             self.controller.phase = Phase.STOP
             return Command(0, 0, Phase.STOP, cmd.error_m), invalid
-        rec, b = self.recovery, self.backoff
-        if moving and b is not None and b.way is not None:  # the lane the way it backs off
-            ahead = self._lane_blocked(frame, cmd, b.way)
-            if ahead:  # nothing to wait in: the back-off's wait is on (recovery.py)
-                rec.give_up(f"no safe way back: {ahead} backing off")
-                self.backoff = None
-                self.stop_reason = self.stop_reason or rec.fault
-                self.controller.phase = Phase.STOP
-                return Command(0, 0, Phase.STOP, cmd.error_m), invalid
         blocked = self._lane_blocked(frame, cmd) if moving and b is None else ""
         if blocked:
             if rec.kind == LANE:
