@@ -375,6 +375,19 @@ class Acquisition:
             dz = float(np.median([p[1] for p in last]) - np.median([p[1] for p in first]))
             dx = float(np.median([p[2] for p in last]) - np.median([p[2] for p in first]))
             moved = math.hypot(dz, dx)
+        if late and self._leg == 1 and self.spent_s > 0 and len(self._track) >= 10 \
+                and not self._shown_so_far(dz, noise_m) and len(self.depths) >= 5:
+            # started again and out of time, its sightings since the last start showing too
+            # little: the whole move since the measure (the robot stood in it) decides, as
+            # standing after (_standing_after) would (seed 15's trial 358 at 0.84 m: dropped
+            # frames and a stale one restarted it after 2.2 cm, the last start saw 1.4 cm of
+            # the 4.8 cm since the measure, and "did not move" left the robot's card out)
+            whole = float(np.median([p[1] for p in self._track[-5:]]) - np.median(self.depths))
+            if self._shown(whole, self._track[-1][1], float(np.median(self._disp[-5:])),
+                           noise_m):
+                self.facing_away = (whole > 0) == (self.direction > 0)
+                self._begin(Phase.DONE, t)
+                return Order(0, 0, Phase.PROBE)
         if late and moved < cfg.probe_m and (self._leg == 2 and self._still or self._leg == 1
                                              and not self._within_noise(noise_m)):
             self.fault = NOT_MOVED  # nothing moved by then: not the robot's marker
