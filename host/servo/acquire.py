@@ -509,11 +509,6 @@ class Acquisition:
                 # it again): as a first leg out of time there, the second leg decides
                 self._second_leg(t, abs(dz) < cfg.probe_m)
                 return Order(0, 0, Phase.PROBE)
-            elif abs(dz) < cfg.probe_m:
-                # near, driven probe_s in all and moved under probe_m: as a first leg so, not
-                # the robot's (seed 15's trial 70: a look-alike at 1.44 m, the robot at 2.22
-                # m, stopped "started again"): the loop looks for another
-                self.fault = NOT_MOVED
             else:
                 self.fault = PROBED_OUT.format(self._out_s)
         elif t - self._after_t0 > cfg.probe_s:
