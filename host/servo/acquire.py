@@ -30,7 +30,10 @@ way the robot faces by what a short probe move does (a pure state machine, one c
              standing sightings against the measure's from before the probe decide on the
              whole move of its starts (beyond probe_m and three of a sighting's noise; a
              far robot backed 10 cm, its move not yet clear, when a stale frame restarted
-             it: dev seed 105's trial 24); not within probe_s: the run stops (PROBED_OUT)
+             it: dev seed 105's trial 24); that move within the noise far away (three of
+             a sighting's noise beyond still_factor probe_m): the second leg, as for a first
+             leg out of time there (seed 15's trial 839); not shown near, or not within
+             probe_s: the run stops (PROBED_OUT)
              (skipped in a re-acquisition that knows the heading: done after the measure);
              a second leg after a first whose sightings showed no move (under probe_m, far)
              goes on beyond the start only on a move back of still_factor probe_m: back at
@@ -147,6 +150,7 @@ class Acquisition:
         self._spin_stood: float | None = None  # the spin test interrupted at (standing since)
         self._spin_cut = False  # the spin test was interrupted: it shows no look-alike
         self.spent_s = spent_s  # the probe's driving before its last start (s)
+        self._unheld = spent_s  # of it, an earlier acquisition's: not in this one's ledger
 
     @property
     def done(self) -> bool:
@@ -371,6 +375,19 @@ class Acquisition:
             dz = float(np.median([p[1] for p in last]) - np.median([p[1] for p in first]))
             dx = float(np.median([p[2] for p in last]) - np.median([p[2] for p in first]))
             moved = math.hypot(dz, dx)
+        if late and self._leg == 1 and self.spent_s > 0 and len(self._track) >= 10 \
+                and not self._shown_so_far(dz, noise_m) and len(self.depths) >= 5:
+            # started again and out of time, its sightings since the last start showing too
+            # little: the whole move since the measure (the robot stood in it) decides, as
+            # standing after (_standing_after) would (seed 15's trial 358 at 0.84 m: dropped
+            # frames and a stale one restarted it after 2.2 cm, the last start saw 1.4 cm of
+            # the 4.8 cm since the measure, and "did not move" left the robot's card out)
+            whole = float(np.median([p[1] for p in self._track[-5:]]) - np.median(self.depths))
+            if self._shown(whole, self._track[-1][1], float(np.median(self._disp[-5:])),
+                           noise_m):
+                self.facing_away = (whole > 0) == (self.direction > 0)
+                self._begin(Phase.DONE, t)
+                return Order(0, 0, Phase.PROBE)
         if late and moved < cfg.probe_m and (self._leg == 2 and self._still or self._leg == 1
                                              and not self._within_noise(noise_m)):
             self.fault = NOT_MOVED  # nothing moved by then: not the robot's marker
@@ -403,13 +420,7 @@ class Acquisition:
             # beyond it, a move twice the first's in the robot's reach of its start: each
             # duty of the first leg held back_factor times as long (_back_duty), so the robot's
             # travel, whatever its speed at each duty, is back_factor times the first leg's
-            self._back_s = cfg.back_factor * self.driven_s()
-            self._back = {}
-            self._still = moved < cfg.probe_m  # the second leg's move decides that too
-            self._leg, self.direction, self.spent_s = 2, -self.direction, 0.0
-            self._track.clear()
-            self._disp.clear()
-            self._begin(Phase.PROBE, t)
+            self._second_leg(t, moved < cfg.probe_m)
             return Order(0, 0, Phase.PROBE)
         if late:  # the facing is not shown: the run stops, rather than drive on a guess
             self.fault = UNSHOWN.format(position[0], 100 * 3 * self._noise(
@@ -421,6 +432,26 @@ class Acquisition:
         self._drive = (t, duty)
         duty *= self.direction
         return Order(duty, duty, Phase.PROBE)
+
+    def _second_leg(self, t: float, still: bool) -> None:
+        """Back the other way from t: through the start and as far beyond it, each of the first
+        leg's duties held back_factor times as long (_back_duty); still: the first leg's move
+        was under probe_m (the second leg's move decides that too). The first leg's driving
+        that its ledger does not hold (an earlier start's, in an acquisition begun again) is
+        counted at the least duty: the second leg then goes back less far, never beyond the
+        first leg's reach of the start, and is back "at the start" no later than the robot."""
+        cfg = self.cfg
+        self._back_s = cfg.back_factor * self.driven_s()
+        if self._unheld > 0:
+            self._levels[cfg.probe_duty] = self._levels.get(cfg.probe_duty, 0.0) + self._unheld
+            self._unheld = 0.0
+        self._back = {}
+        self._still = still
+        self._leg, self.direction, self.spent_s = 2, -self.direction, 0.0
+        self._after = None
+        self._track.clear()
+        self._disp.clear()
+        self._begin(Phase.PROBE, t)
 
     def _shown_so_far(self, dz: float, noise_m: float) -> bool:
         """Whether the track's move dz (m) already shows its sign (_shown; ten sightings)."""
@@ -465,11 +496,19 @@ class Acquisition:
         if position is not None:
             self._after.append(position[0])
         if len(self._after) >= 10:
-            dz = float(np.median(self._after) - np.median(self.depths))
-            if self._shown(dz, float(np.median(self._after)),
-                           float(np.median(self.disparities)), noise_m):
+            z = float(np.median(self._after))
+            d = float(np.median(self.disparities))
+            dz = z - float(np.median(self.depths))
+            if self._shown(dz, z, d, noise_m):
                 self.facing_away = (dz > 0) == (self.direction > 0)
                 self._begin(Phase.DONE, t)
+            elif 3 * self._noise(z, d, noise_m) > cfg.still_factor * cfg.probe_m \
+                    and self._leg == 1:
+                # far away, the whole move within the noise (seed 15's trial 839 backed 10 cm
+                # at 2.45 m, its sightings showed 6 cm against 6.7; a stale frame had started
+                # it again): as a first leg out of time there, the second leg decides
+                self._second_leg(t, abs(dz) < cfg.probe_m)
+                return Order(0, 0, Phase.PROBE)
             else:
                 self.fault = PROBED_OUT.format(self._out_s)
         elif t - self._after_t0 > cfg.probe_s:
