@@ -16,7 +16,7 @@ import shutil
 import subprocess
 from pathlib import Path
 
-from host.emulator.build import CACHE
+from host.emulator.build import CACHE, BuildFailed
 
 PENDING = 4096  # the motor outputs waiting out their latency (at most one a millisecond)
 INBOUND = 1024  # the host's bytes on their way to the core, as handed in per call
@@ -192,7 +192,8 @@ _tried = False
 
 def library() -> ctypes.CDLL | None:
     """The compiled run_ms (built once into the user cache, keyed by its source), or None
-    where it cannot be built (no gcc): the caller's Python loop then runs, the same steps."""
+    where it cannot be built (no gcc) or STEREO_SERVO_NO_FAST_MS is set: the caller's Python
+    loop then runs, the same steps. Code of ours that does not compile is BuildFailed."""
     global _lib, _tried
     if _tried:
         return _lib
@@ -212,7 +213,7 @@ def library() -> ctypes.CDLL | None:
                            capture_output=True, text=True)
         src.unlink()
         if r.returncode:
-            raise RuntimeError(f"building the compiled millisecond failed: {r.stderr[:300]}")
+            raise BuildFailed(f"building the compiled millisecond failed: {r.stderr[:300]}")
         os.replace(tmp, lib)
     _lib = ctypes.CDLL(str(Path(lib)))
     _lib.run_ms.argtypes = [ctypes.POINTER(State), ctypes.c_int64, ctypes.c_int64,

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import random
+from typing import Any
 
 import pytest
 
@@ -21,7 +22,7 @@ from tests.sim.test_lockstep_native import MOTOR
 from tests.sim.test_lockstep_speedup import EVENTS
 
 
-def _pending(src: SimSource) -> tuple:
+def _pending(src: SimSource) -> tuple[object, ...]:
     """The motor outputs waiting out their latency, wherever they are kept."""
     out = list(src._pending)
     fast = src._fast
@@ -33,7 +34,7 @@ def _pending(src: SimSource) -> tuple:
     return tuple(out)
 
 
-def _run(frames: int) -> list[tuple]:
+def _run(frames: int) -> list[tuple[Any, ...]]:
     world = World.for_size(160, 120, seed=4, motor_faults=MOTOR,
                            boxes=(Box(1.3, -0.3, 0.2, 0.4), Box(2.2, 0.4, 0.9, 0.5)))
     world.robot.z_m = 2.0
