@@ -60,6 +60,20 @@ class ByteDraws:
         drop, corrupt, xor = block[n % self.BLOCK]
         return float(drop), float(corrupt), 1 + int(xor * 255)
 
+    def rows(self, direction: int, n0: int, count: int) -> list[list[float]]:
+        """The draws (drop, corrupt, xor as drawn) of bytes n0 .. n0+count-1 of a direction:
+        at()'s, taken a block's run at a time (a frame's bytes in one slice, not one numpy
+        index and three conversions a byte)."""
+        out: list[list[float]] = []
+        n, end = n0, n0 + count
+        while n < end:
+            self.at(direction, n)  # its block, made or kept as at() keeps it
+            block = self._blocks[(direction, n // self.BLOCK)]
+            stop = min(end, (n // self.BLOCK + 1) * self.BLOCK)
+            out += block[n % self.BLOCK:n % self.BLOCK + stop - n].tolist()
+            n = stop
+        return out
+
 
 class Emulator:
     """The firmware core, a clock in ms, and the serial line to the host.
@@ -100,12 +114,13 @@ class Emulator:
         if not (f.drop or f.corrupt):
             return list(data)
         out = []
-        for i, b in enumerate(data):
-            drop, corrupt, xor = self._draws.at(direction, n0 + i)
-            if drop < f.drop:
+        p_drop, p_corrupt = f.drop, f.corrupt
+        for b, (drop, corrupt, xor) in zip(data, self._draws.rows(direction, n0, len(data)),
+                                           strict=True):
+            if drop < p_drop:
                 continue
-            if corrupt < f.corrupt:
-                b ^= xor
+            if corrupt < p_corrupt:
+                b ^= 1 + int(xor * 255)
             out.append(b)
         return out
 

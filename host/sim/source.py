@@ -3,18 +3,20 @@ both in one deterministic simulated clock (lockstep: processing takes no simulat
 
 from __future__ import annotations
 
+import ctypes
 import math
 from collections import deque
 
 import numpy as np
 
 from host.camera.source import StereoFrame, StereoSource
+from host.emulator import fast_ms
 from host.emulator.board import Board
 from host.emulator.emulator import Emulator, Lockstep
 from host.sim.faults import Event
 from host.sim.rectify import Changed
 from host.sim.renderer import Flicker, Renderer
-from host.sim.world import Box, Person, Robot, World
+from host.sim.world import Box, Motors, Person, Robot, World
 
 
 def _first_ms(t_s: float) -> int:
@@ -26,6 +28,63 @@ def _first_ms(t_s: float) -> int:
     while n / 1000 < t_s:
         n += 1
     return n
+
+
+_NONE = 1 << 20  # no motor outputs queued yet (outside int16)
+_FAR = 1 << 62  # no scene event to come
+
+
+class _Compiled:
+    """The compiled millisecond's state (host.emulator.fast_ms.State) for one native core and
+    one world generator: the core's functions and the generator's draw bound once."""
+
+    def __init__(self, lib: ctypes.CDLL, parts: Lockstep, w: World) -> None:
+        self.parts, self.rng = parts, w.rng
+        self.s = s = fast_ms.State()
+        self.ref = ctypes.byref(s)
+        self.reason = ctypes.c_int32()
+        self.reason_ref = ctypes.byref(self.reason)
+        self.run = lib.run_ms
+        self.txbuf = ctypes.create_string_buffer(4096)
+        core_lib = parts.core._lib
+        self._draws = w.rng.bit_generator.ctypes  # kept alive with the pointers taken from it
+
+        def addr(fn: object) -> int | None:
+            return ctypes.cast(fn, ctypes.c_void_p).value  # type: ignore[arg-type]
+
+        s.guard, s.tick = addr(core_lib.robot_guard), addr(core_lib.robot_tick)
+        s.take, s.motors = addr(core_lib.emu_take_tx), addr(core_lib.emu_motors)
+        s.rx = addr(core_lib.robot_rx_byte)
+        s.draw, s.draw_state = addr(self._draws.next_double), self._draws.state_address
+        s.txbuf, s.txcap = ctypes.addressof(self.txbuf), len(self.txbuf)
+        m = w.motors
+        s.dt, s.wheelbase = 0.001, m.wheelbase_m
+        s.v_max, s.dead_zone, s.span = m.v_max_mps, m.dead_zone, 1000 - m.dead_zone
+
+    def load_world(self, w: World) -> None:
+        s, r = self.s, w.robot
+        s.t, s.travelled = w.t, w.travelled_m
+        s.v_left, s.v_right, s.theta, s.x, s.z = r.v_left, r.v_right, r.theta, r.x_m, r.z_m
+        s.traction[0], s.traction[1] = w.traction
+
+    def save_world(self, w: World) -> None:
+        s, r = self.s, w.robot
+        w.t, w.travelled_m = s.t, s.travelled
+        r.v_left, r.v_right, r.theta, r.x_m, r.z_m = s.v_left, s.v_right, s.theta, s.x, s.z
+
+    def load_inbound(self, inbound: deque[tuple[float, int]]) -> None:
+        s = self.s
+        for i, (due, b) in enumerate(inbound):
+            s.in_due[i], s.in_byte[i] = due, b
+        s.in_len, s.in_used = len(inbound), 0
+
+    def take_inbound(self, inbound: deque[tuple[float, int]]) -> None:
+        """The bytes the core was handed off the line's queue."""
+        s = self.s
+        if s.in_used:
+            for _ in range(s.in_used):
+                inbound.popleft()
+            self.load_inbound(inbound)
 
 
 class SimSource(StereoSource):
@@ -63,6 +122,7 @@ class SimSource(StereoSource):
         self._made: list[tuple[np.ndarray, Changed | None] | None] = [None, None]
         self.log: list[str] = []  # what happened in the scene, with times
         self._parts: Lockstep | None = None  # the native board's millisecond (_native)
+        self._fast: _Compiled | None = None  # its compiled form (_run_ms_compiled)
 
     @property
     def t(self) -> float:
@@ -86,6 +146,7 @@ class SimSource(StereoSource):
             with parts.emu.lock:
                 self._run_ms_native(ms, parts, until_tx=False)
             return
+        self._pending_back()
         board, step, pending = self.board, self.world.step, self._pending
         latency = int(round(self.latency_ms))
         wake = self._wake_ms()
@@ -132,6 +193,103 @@ class SimSource(StereoSource):
         return parts
 
     def _run_ms_native(self, ms: int, parts: Lockstep, until_tx: bool) -> None:
+        """run_ms with the native core's board: compiled (host.emulator.fast_ms) where it
+        builds, else _run_ms_loop; the same steps either way."""
+        if ms <= 0:
+            return
+        fast = self._compiled(parts)
+        if fast is not None and len(parts.emu._inbound) <= fast_ms.INBOUND:
+            self._run_ms_compiled(ms, fast, until_tx)
+        else:
+            self._pending_back()
+            self._run_ms_loop(ms, parts, until_tx)
+
+    def _compiled(self, parts: Lockstep) -> _Compiled | None:
+        """The compiled millisecond's state for these parts (made again for a new core or a
+        new generator), or None where it does not build or the motors are not the plain
+        model."""
+        fast = self._fast
+        w = self.world
+        if fast is not None and fast.parts is parts and fast.rng is w.rng:
+            return fast
+        lib = fast_ms.library()
+        if lib is None or type(w.motors) is not Motors:
+            return None
+        if fast is not None:
+            self._pending_back()
+        self._fast = fast = _Compiled(lib, parts, w)
+        return fast
+
+    def _pending_back(self) -> None:
+        """The compiled loop's queue of motor outputs back into _pending (for the loops in
+        Python)."""
+        fast = self._fast
+        if fast is None or not fast.s.pend_len:
+            return
+        s = fast.s
+        for _ in range(s.pend_len):
+            i = s.pend_head
+            self._pending.append((s.pend_due[i], (s.pend_m[i][0], s.pend_m[i][1])))
+            s.pend_head = (i + 1) % fast_ms.PENDING
+            s.pend_len -= 1
+
+    def _run_ms_compiled(self, ms: int, fast: _Compiled, until_tx: bool) -> None:
+        """_run_ms_loop's milliseconds in C (host.emulator.fast_ms.run_ms) between the scene's
+        events and the board's bytes for the host, which are handled here as there."""
+        s, w, emu = fast.s, self.world, fast.parts.emu
+        f = w.motor_faults
+        inbound, outbound = emu._inbound, emu._outbound
+        pending = self._pending
+        while pending:  # from a loop in Python before
+            due, (left, right) = pending.popleft()
+            i = (s.pend_head + s.pend_len) % fast_ms.PENDING
+            s.pend_due[i], s.pend_m[i][0], s.pend_m[i][1] = due, left, right
+            s.pend_len += 1
+        s.a = 1.0 - math.exp(-0.001 / w.motors.tau_s)
+        s.sag, s.push, s.slip = f.sag_per_m, f.push_mps, f.slip
+        s.gain[0], s.gain[1] = f.gain
+        s.offset[0], s.offset[1] = f.offset
+        s.latency = int(round(self.latency_ms))
+        s.applied[0], s.applied[1] = self._applied
+        queued = self._queued
+        s.queued[0], s.queued[1] = queued if queued is not None else (_NONE, _NONE)
+        s.emu_now, s.ticked = emu.now_ms, emu._ticked_ms
+        s.until_tx = until_tx
+        fast.load_world(w)
+        fast.load_inbound(inbound)
+        s.outbound_due = outbound[0][0] if outbound else math.inf
+        now, end = self.now_ms, self.now_ms + ms
+        wake = self._wake_ms()
+        reason, run = fast.reason, fast.run
+        try:
+            while now < end:
+                if now >= wake:
+                    self.now_ms = now
+                    fast.save_world(w)
+                    self._apply_events()
+                    wake = self._wake_ms()
+                    fast.load_world(w)
+                now += run(fast.ref, now, end, _FAR if wake == math.inf else int(wake),
+                           fast.reason_ref)
+                why = reason.value
+                if why == fast_ms.TX:
+                    emu.now_ms, emu._ticked_ms = s.emu_now, s.ticked
+                    fast.take_inbound(inbound)
+                    emu._queue_tx(fast.txbuf.raw[:s.k])
+                    if until_tx and outbound and outbound[0][0] <= emu.now_ms:
+                        break
+                    s.outbound_due = outbound[0][0] if outbound else math.inf
+                elif why != fast_ms.BEFORE:
+                    break
+        finally:
+            self.now_ms = now
+            fast.save_world(w)
+            emu.now_ms, emu._ticked_ms = s.emu_now, s.ticked
+            fast.take_inbound(inbound)
+            self._applied = (s.applied[0], s.applied[1])
+            self._queued = None if s.queued[0] == _NONE else (s.queued[0], s.queued[1])
+
+    def _run_ms_loop(self, ms: int, parts: Lockstep, until_tx: bool) -> None:
         """run_ms with the native core's board: the same steps, in one loop (the world's step
         and the board's advance(1) written out here; World.step and Emulator.advance say what
         each does)."""
