@@ -183,7 +183,7 @@ def find_discs(image: np.ndarray, min_radius: float = 2.5, max_radius: float = 8
         return blobs
     # the cheapest tests first, every outline in one pass (_screen): its bounding box's
     # aspect, its box's room for the area ((w - 1)(h - 1)), its area and its roundness
-    sizes = np.fromiter((c.shape[0] for c in outlines), np.intp, len(outlines))
+    sizes = np.fromiter(map(len, outlines), np.intp, len(outlines))
     points = np.concatenate(outlines).reshape(-1, 2)
     for i, x, y, w, h in _screen(points, sizes, min_area, math.pi * max_radius ** 2):
         c = outlines[i]
@@ -200,15 +200,16 @@ def find_discs(image: np.ndarray, min_radius: float = 2.5, max_radius: float = 8
 
 
 def _outlines(mask: np.ndarray, min_area: float) -> list[np.ndarray]:
-    """The outer contours of the mask's blobs that could enclose min_area px: a textured scene
-    leaves thousands of specks. A closed contour of n points (steps of at most sqrt 2 px)
-    encloses at most (n sqrt 2)^2 / (4 pi) px, so shorter ones are dropped unmeasured; the
-    specks whose box find_discs would drop are cleared before the contours are traced
-    (_without_specks), which leaves the others' contours as they were."""
-    contours, _ = cv2.findContours(_without_specks(mask, min_area), cv2.RETR_EXTERNAL,
+    """The outer contours of the mask's blobs that find_discs' box tests may keep, and of the
+    blobs with such a one in their hole: a textured scene leaves thousands of specks and many
+    lines. Those whose box find_discs would drop and whose box holds no other such blob are
+    cleared before the contours are traced (_without_dropped), which leaves the others'
+    contours as they were. (A closed contour of n points, steps of at most sqrt 2 px, encloses
+    at most (n sqrt 2)^2 / (4 pi) px: those shorter than sqrt(2 pi min_area) fail _screen's
+    area test, and need no test of their own.)"""
+    contours, _ = cv2.findContours(_without_dropped(mask, min_area), cv2.RETR_EXTERNAL,
                                    cv2.CHAIN_APPROX_NONE)
-    shortest = math.sqrt(2 * math.pi * min_area)
-    return [c for c in contours if c.shape[0] >= shortest]
+    return list(contours)
 
 
 @njit(cache=True)
@@ -280,6 +281,21 @@ def _without_specks(mask: np.ndarray, min_area: float) -> np.ndarray:
     so none is newly outermost. Labelled by runs of a row joined to the runs they touch in
     the row above (a union-find): the contours of thousands of specks cost cv2.findContours
     more than this."""
+    return _cleared(mask, min_area, False)
+
+
+@njit(cache=True)
+def _without_dropped(mask: np.ndarray, min_area: float) -> np.ndarray:
+    """_without_specks, and without the blobs whose box find_discs drops for its aspect (w / h
+    not within 0.75-1.33: lines, the edges of boxes) unless another blob left lies within that
+    box: a blob in one's hole lies strictly inside its box, so clearing one with none there
+    makes no blob newly outermost, and the contours left are those of the whole mask."""
+    return _cleared(mask, min_area, True)
+
+
+@njit(cache=True)
+def _cleared(mask: np.ndarray, min_area: float, by_aspect: bool) -> np.ndarray:
+    # _without_specks (by_aspect False) and _without_dropped (True)
     h, w = mask.shape
     cap = h * ((w + 1) // 2) + 1
     run_y = np.empty(cap, np.int32)
@@ -317,10 +333,33 @@ def _without_specks(mask: np.ndarray, min_area: float) -> np.ndarray:
         hi_x[r] = max(hi_x[r], run_x1[i] - 1)
         lo_y[r] = min(lo_y[r], run_y[i])
         hi_y[r] = max(hi_y[r], run_y[i])
+    drop = np.zeros(n, np.bool_)  # by root
+    kept = np.empty(n, np.int32)  # the roots of the blobs not specks
+    nk = 0
+    for r in range(n):
+        if parent[r] == r:
+            if (hi_x[r] - lo_x[r]) * (hi_y[r] - lo_y[r]) < min_area:
+                drop[r] = True
+            else:
+                kept[nk] = r
+                nk += 1
+    if by_aspect:
+        for k in range(nk):
+            r = kept[k]
+            ratio = (hi_x[r] - lo_x[r] + 1) / (hi_y[r] - lo_y[r] + 1)  # as _screen's
+            if ratio > 0.75 and ratio < 1.33:
+                continue
+            holds = False
+            for m in range(nk):
+                q = kept[m]
+                if q != r and lo_x[q] >= lo_x[r] and hi_x[q] <= hi_x[r] \
+                        and lo_y[q] >= lo_y[r] and hi_y[q] <= hi_y[r]:
+                    holds = True
+                    break
+            drop[r] = not holds
     out = mask.copy()
     for i in range(n):
-        r = parent[i]
-        if (hi_x[r] - lo_x[r]) * (hi_y[r] - lo_y[r]) < min_area:
+        if drop[parent[i]]:
             out[run_y[i], run_x0[i]:run_x1[i]] = 0
     return out
 
