@@ -40,7 +40,42 @@ class MarkerPair:
         return self.left.u - self.right.u
 
 
-_OPEN = np.ones((2, 2), np.uint8)  # the opening that removes one-pixel specks of the mask
+@njit(cache=True)
+def _dark_opened(grey: np.ndarray, local: np.ndarray) -> np.ndarray:
+    """The mask of the pixels darker than their neighbourhood's mean by 40 (255, else 0),
+    opened with a 2x2 square to remove one-pixel specks: what cv2.compare(grey,
+    cv2.subtract(local, 40), cv2.CMP_LT) and cv2.morphologyEx(MORPH_OPEN, np.ones((2, 2)))
+    give, bit for bit (the kernel's anchor (1, 1): each of the erosion and the dilation takes
+    a pixel, its left, upper and upper-left neighbours; outside the image counts for neither),
+    in one call instead of four."""
+    h, w = grey.shape
+    dark = np.empty((h, w), np.uint8)
+    for y in range(h):
+        for x in range(w):
+            dark[y, x] = 255 if np.int32(grey[y, x]) < np.int32(local[y, x]) - 40 else 0
+    eroded = np.empty((h, w), np.uint8)
+    for y in range(h):
+        for x in range(w):
+            m = dark[y, x]
+            if x > 0:
+                m = min(m, dark[y, x - 1])
+            if y > 0:
+                m = min(m, dark[y - 1, x])
+                if x > 0:
+                    m = min(m, dark[y - 1, x - 1])
+            eroded[y, x] = m
+    out = np.empty((h, w), np.uint8)
+    for y in range(h):
+        for x in range(w):
+            m = eroded[y, x]
+            if x > 0:
+                m = max(m, eroded[y, x - 1])
+            if y > 0:
+                m = max(m, eroded[y - 1, x])
+                if x > 0:
+                    m = max(m, eroded[y - 1, x - 1])
+            out[y, x] = m
+    return out
 
 
 def _centroid(grey: np.ndarray, cx: float, cy: float, r: float) -> tuple[float, float]:
@@ -173,9 +208,7 @@ def find_discs(image: np.ndarray, min_radius: float = 2.5, max_radius: float = 8
     grey = to_grey(image)
     # dark relative to the neighbourhood: the ring makes the disc stand out locally (grey <
     # local - 40; where local < 40 the saturated difference is 0 and nothing is below it)
-    local = cv2.blur(grey, (window, window))
-    mask = cv2.compare(grey, cv2.subtract(local, np.full_like(local, 40)), cv2.CMP_LT)  # 255: dark
-    mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, _OPEN)
+    mask = _dark_opened(grey, cv2.blur(grey, (window, window)))  # 255: dark
     blobs: list[Blob] = []
     min_area = math.pi * min_radius ** 2
     outlines = _outlines(mask, min_area)
