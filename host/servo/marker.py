@@ -306,29 +306,15 @@ def _root(parent: np.ndarray, i: int) -> int:
 
 
 @njit(cache=True)
-def _without_specks(mask: np.ndarray, min_area: float) -> np.ndarray:
-    """A copy of the mask (uint8, 0 or not) without its 8-connected blobs whose bounding box
-    (w, h px) has (w - 1)(h - 1) < min_area: find_discs drops their contours by that test
-    (an outer contour's box is its blob's), and clearing them changes no other contour: a
-    contour is traced round its own blob, and a blob inside one's hole has a smaller box,
-    so none is newly outermost. Labelled by runs of a row joined to the runs they touch in
-    the row above (a union-find): the contours of thousands of specks cost cv2.findContours
-    more than this."""
-    return _cleared(mask, min_area, False)
-
-
-@njit(cache=True)
 def _without_dropped(mask: np.ndarray, min_area: float) -> np.ndarray:
-    """_without_specks, and without the blobs whose box find_discs drops for its aspect (w / h
-    not within 0.75-1.33: lines, the edges of boxes) unless another blob left lies within that
-    box: a blob in one's hole lies strictly inside its box, so clearing one with none there
-    makes no blob newly outermost, and the contours left are those of the whole mask."""
-    return _cleared(mask, min_area, True)
-
-
-@njit(cache=True)
-def _cleared(mask: np.ndarray, min_area: float, by_aspect: bool) -> np.ndarray:
-    # _without_specks (by_aspect False) and _without_dropped (True)
+    """A copy of the mask (uint8, 0 or not) without the 8-connected blobs whose contours
+    find_discs drops by their bounding box (w, h px) alone: the specks, (w - 1)(h - 1) <
+    min_area, and those whose aspect w / h is not within 0.75-1.33 (lines, the edges of
+    boxes) unless another blob left lies within that box. Clearing them changes no other
+    contour: a contour is traced round its own blob, and a blob in one's hole lies strictly
+    inside its box, so none is newly outermost; the contours left are those of the whole mask.
+    Labelled by runs of a row joined to the runs they touch in the row above (a union-find):
+    the contours of thousands of specks cost cv2.findContours more than this."""
     h, w = mask.shape
     cap = h * ((w + 1) // 2) + 1
     run_y = np.empty(cap, np.int32)
@@ -376,20 +362,19 @@ def _cleared(mask: np.ndarray, min_area: float, by_aspect: bool) -> np.ndarray:
             else:
                 kept[nk] = r
                 nk += 1
-    if by_aspect:
-        for k in range(nk):
-            r = kept[k]
-            ratio = (hi_x[r] - lo_x[r] + 1) / (hi_y[r] - lo_y[r] + 1)  # as _screen's
-            if ratio > 0.75 and ratio < 1.33:
-                continue
-            holds = False
-            for m in range(nk):
-                q = kept[m]
-                if q != r and lo_x[q] >= lo_x[r] and hi_x[q] <= hi_x[r] \
-                        and lo_y[q] >= lo_y[r] and hi_y[q] <= hi_y[r]:
-                    holds = True
-                    break
-            drop[r] = not holds
+    for k in range(nk):
+        r = kept[k]
+        ratio = (hi_x[r] - lo_x[r] + 1) / (hi_y[r] - lo_y[r] + 1)  # as _screen's
+        if ratio > 0.75 and ratio < 1.33:
+            continue
+        holds = False
+        for m in range(nk):
+            q = kept[m]
+            if q != r and lo_x[q] >= lo_x[r] and hi_x[q] <= hi_x[r] \
+                    and lo_y[q] >= lo_y[r] and hi_y[q] <= hi_y[r]:
+                holds = True
+                break
+        drop[r] = not holds
     out = mask.copy()
     for i in range(n):
         if drop[parent[i]]:
