@@ -112,6 +112,12 @@ class ControlConfig:
     half_length_m: float = 0.08  # centre to front (and back): a run sweeps this rectangle
     # (clearance.swept), turned by the heading, grown by block_margin_m and half a cell
     path_margin_m: float = 0.10  # fixed objects this far beyond the target's depth are in its path
+    # the lane keeps this much more from another fixed object's cells than from the object: the
+    # servo's check sweeps the body on the learnt heading within its spread (up to 15 degrees:
+    # the front corner and 10 cm of run 3-4 cm across), and at 15 cm centre to side by box 2's
+    # end the spread's edge met its cells (seed 15: 6 of the 14 traced drive stops, the robot
+    # within 3 cm of its lane); taken only where it leaves the lane on the same side (lane)
+    spread_room_m: float = 0.03
     cell_m: float = 0.02  # the fixed objects' floor cells (perception.fixed_cells)
     push_horizon_s: float = 3.0  # standing, a sideways drift that would bring the body onto
     # the object within this long ends the run (it cannot move sideways in place)
@@ -255,10 +261,22 @@ class Controller:
         x = self.lateral_ref
         if x is None:
             return x
+        plain = self._lane(x, depth_m, 0.0)
+        room = self.cfg.spread_room_m
+        if depth_m is None or room <= 0:
+            return plain
+        # with spread_room_m more from the other fixed objects, where that lane is the same
+        # one moved by at most that room (a gap it closes, or a side it changes, is not taken)
+        wide = self._lane(x, depth_m, room)
+        return wide if abs(wide - plain) <= room + 1e-9 else plain
+
+    def _lane(self, x: float, depth_m: float | None, room: float) -> float:
+        """The lane from the first seen lateral x: clear of the object by clearance_m and of
+        the other fixed objects ahead (given depth_m) by clearance_m + room, centre to side."""
         c = self.cfg.clearance_m
         spans = [] if self.keep_out is None else [(self.keep_out[0] - c, self.keep_out[1] + c)]
         if depth_m is not None:
-            r = c + self.cfg.cell_m / 2
+            r = c + room + self.cfg.cell_m / 2
             spans += [(float(u) - r, float(u) + r) for u in self.ahead(depth_m)[:, 1]]
         for lo, hi in merged(spans):
             if lo < x < hi:
