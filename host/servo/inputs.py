@@ -16,6 +16,7 @@ import math
 
 import cv2
 import numpy as np
+from numba import njit
 
 from host.camera.source import StereoFrame
 from host.servo.perception import Floor, Target
@@ -62,10 +63,49 @@ class FrozenSensors:
 
 
 def _row_mode(row: np.ndarray) -> float:
-    """The most common disparity of a row's valid pixels (0.25 px bins)."""
-    hist, edges = np.histogram(row, bins=np.arange(row.min(), row.max() + 0.5, 0.25))
-    k = int(np.argmax(hist))
+    """The most common disparity of a row's valid pixels (0.25 px bins).
+
+    np.histogram(row, bins=edges)'s fullest bin (the first of equal counts) is counted by
+    _fullest_bin at a fraction of its CPU (it sorts the row and calls searchsorted per block:
+    3.6 % of a trial's CPU; issue 25), with the same edges (np.arange's own, made here)."""
+    lo, hi = _extremes(row)
+    kind = row.dtype.type  # row.min() and row.max() as np.arange had them (+ 0.5 in their type)
+    edges = np.arange(kind(lo), kind(hi) + 0.5, 0.25)
+    k = _fullest_bin(row, edges)
     return float((edges[k] + edges[k + 1]) / 2)
+
+
+@njit(cache=True)
+def _extremes(values: np.ndarray) -> tuple[float, float]:
+    """(values.min(), values.max()) in one pass; NaN for both if any value is NaN."""
+    lo = hi = values[0]
+    for v in values:
+        if np.isnan(v):
+            return np.nan, np.nan
+        lo = min(lo, v)
+        hi = max(hi, v)
+    return lo, hi
+
+
+@njit(cache=True)
+def _fullest_bin(values: np.ndarray, edges: np.ndarray) -> int:
+    """The index of np.histogram(values, bins=edges)'s first fullest bin: bin i holds
+    edges[i] <= v < edges[i + 1], the last bin also v == edges[-1] (edges ascending; values
+    outside them, or NaN, in none). The comparisons are in float64, as searchsorted's."""
+    n = edges.size - 1
+    counts = np.zeros(max(n, 1), np.int64)
+    lo, hi = edges[0], edges[n]
+    for v in values:
+        f = np.float64(v)
+        if not lo <= f <= hi:
+            continue
+        i = n - 1 if f == hi else np.searchsorted(edges, f, side="right") - 1
+        counts[i] += 1
+    best = 0
+    for i in range(n):
+        if counts[i] > counts[best]:
+            best = i
+    return best
 
 
 def floor_shift_px(disp: np.ndarray, floor: Floor, min_rows: int = 10,

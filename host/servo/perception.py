@@ -127,10 +127,16 @@ def nearest_object(disp: np.ndarray, min_area: int, step: float = 0.5,
         levels.append(level)
         level -= step
     seen: dict[int, tuple[int, np.ndarray, np.ndarray]] = {}
+    too_few: set[int] = set()  # levels with fewer than min_area pixels in all: no region reaches
 
     def reaches(k: int) -> bool:
+        if k in too_few:
+            return False
         if k not in seen:
             mask = (clean >= levels[k]).astype(np.uint8)
+            if np.count_nonzero(mask) < min_area:  # not labelled (dev 105: half the labellings)
+                too_few.add(k)
+                return False
             seen[k] = cv2.connectedComponentsWithStats(mask, connectivity=4)[:3]
         n, _, stats = seen[k]
         return n > 1 and int(stats[1:, cv2.CC_STAT_AREA].max()) >= min_area

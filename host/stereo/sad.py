@@ -17,6 +17,8 @@ outside masked, instead of one plain loop per candidate.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit, prange
 
@@ -33,6 +35,15 @@ LANES = 32
 # vectors): LLVM's main body takes 64 lanes at a time, so 48, 56 or 96 candidates ran part of
 # every column in the remainder loop (640 columns: 48 took 7.0-10.1 us a row, 64 5.3-8.0)
 COL_LANES = 64
+
+
+class RightCosts(NamedTuple):
+    """A band's working arrays for the right map (_keep_costs, _right_row)."""
+
+    costs: np.ndarray  # (w + 2, nd): row x + 1 holds output x's costs
+    low: np.ndarray  # (w + dmin + nd - 1,): at xr + dmin + nd - 1, right pixel xr's lowest
+    # cost so far in the row
+    at: np.ndarray  # the same shape: the smallest candidate with that cost
 
 
 def lane_types(channels: int, size: int) -> tuple[type, type]:
@@ -156,14 +167,27 @@ def _slide(win, enter, leave):
 
 
 @njit(cache=True, fastmath=True, inline="always")
-def _keep_costs(skew, win, x, kmin, nd):
-    # output x's costs of candidates kmin .. nd - 1 where the right map reads them (skew)
+def _keep_costs(rc, win, x, kmin, nd):
+    """Output x's costs of candidates kmin .. nd - 1, for the right map (_right_row): kept
+    as they are (rc.costs[x + 1], contiguous), and folded into the running minimum of
+    each right pixel they belong to (candidate k of x is right pixel x + k - dmin - nd + 1,
+    at rc.low[x + k] / rc.at[x + k]), all contiguous in k. x rises, so a right pixel's
+    candidates come in falling k: taking a cost equal to the minimum so far keeps the
+    smallest k of the minimum, the one the first-index scan of its costs found."""
+    costs = rc.costs[x + 1]
     for k in range(kmin, nd):
-        skew[x + k, k] = win[k]
+        costs[k] = win[k]
+    low = rc.low[x:x + nd]
+    at = rc.at[x:x + nd]
+    for k in range(kmin, nd):
+        c = win[k]
+        take = c <= low[k]
+        low[k] = c if take else low[k]
+        at[k] = k if take else at[k]
 
 
 @njit(cache=True, fastmath=True, inline="always")
-def _interior(col, win, floor, idx, skew, out, yi, x_from, x_to, half, dmin, nd, fit,
+def _interior(col, win, floor, idx, rc, out, yi, x_from, x_to, half, dmin, nd, fit,
               want_right):
     """The common case: both window columns inside, every candidate allowed, no uniqueness.
 
@@ -172,7 +196,7 @@ def _interior(col, win, floor, idx, skew, out, yi, x_from, x_to, half, dmin, nd,
     for x in range(x_from, x_to):
         best, m = _slide_lowest(win, floor, idx, col, x + half, x - half - 1)
         if want_right:
-            _keep_costs(skew, win, x, 0, nd)
+            _keep_costs(rc, win, x, 0, nd)
         off = 0.0
         if fit != FIT_NONE and 0 < best < nd - 1:
             off = fit_offset(np.float32(win[best - 1]), np.float32(m),
@@ -181,7 +205,7 @@ def _interior(col, win, floor, idx, skew, out, yi, x_from, x_to, half, dmin, nd,
 
 
 @njit(cache=True, fastmath=True, inline="always")
-def _edge(col, win, floor, idx, efloor, eidx, skew, out, yi, x_from, x_to, half, dmin, nd, fit,
+def _edge(col, win, floor, idx, efloor, eidx, rc, out, yi, x_from, x_to, half, dmin, nd, fit,
           want_right):
     """Outputs whose right windows leave the image for some candidates (kmin > 0): both window
     columns inside, no uniqueness. As _interior, with the candidates below kmin lifted out by
@@ -198,7 +222,7 @@ def _edge(col, win, floor, idx, efloor, eidx, skew, out, yi, x_from, x_to, half,
         eidx[kmin] = idx[kmin]
         best, m = _slide_lowest(win, efloor, eidx, col, x + half, x - half - 1)
         if want_right:
-            _keep_costs(skew, win, x, kmin, nd)
+            _keep_costs(rc, win, x, kmin, nd)
         off = 0.0
         if fit != FIT_NONE and kmin < best < nd - 1:
             off = fit_offset(np.float32(win[best - 1]), np.float32(m),
@@ -207,10 +231,10 @@ def _edge(col, win, floor, idx, efloor, eidx, skew, out, yi, x_from, x_to, half,
 
 
 @njit(cache=True, fastmath=True)
-def _row_outputs(col, win, zero, floor, idx, efloor, eidx, skew, out, yi, x_from, x_to,
+def _row_outputs(col, win, zero, floor, idx, efloor, eidx, rc, out, yi, x_from, x_to,
                  x_start, half, w, dmin, nd, uniqueness, fit, want_right):
     """Slide the window over outputs x in [x_from, x_to) of one row, writing out[yi, x] (and,
-    want_right, each output's costs into skew for _right_row)."""
+    want_right, each output's costs into rc for _right_row)."""
     if x_from == x_start:
         win[:] = 0
         for xx in range(max(0, x_start - half), x_start + half):
@@ -228,12 +252,12 @@ def _row_outputs(col, win, zero, floor, idx, efloor, eidx, skew, out, yi, x_from
     x = x_from
     while x < x_to:
         if x == edge_lo:
-            _edge(col, win, floor, idx, efloor, eidx, skew, out, yi, edge_lo, edge_hi, half,
+            _edge(col, win, floor, idx, efloor, eidx, rc, out, yi, edge_lo, edge_hi, half,
                   dmin, nd, fit, want_right)
             x = edge_hi
             continue
         if x == fast_lo:
-            _interior(col, win, floor, idx, skew, out, yi, fast_lo, fast_hi, half, dmin, nd,
+            _interior(col, win, floor, idx, rc, out, yi, fast_lo, fast_hi, half, dmin, nd,
                       fit, want_right)
             x = fast_hi
             continue
@@ -251,30 +275,33 @@ def _row_outputs(col, win, zero, floor, idx, efloor, eidx, skew, out, yi, x_from
                 continue
             k = _argmin(win, kmin, nd)
         if want_right:
-            _keep_costs(skew, win, x - 1, kmin, nd)
+            _keep_costs(rc, win, x - 1, kmin, nd)
         off, ok = _decide(win, k, kmin, nd, uniqueness, fit)
         if ok:
             out[yi, x - 1] = dmin + nd - 1 - k - off
 
 
 @njit(cache=True, fastmath=True)
-def _right_row(skew, disp_r, y, w, dmin, nd, top, fit):
+def _right_row(rc, disp_r, y, w, dmin, nd, top, fit):
     """The right map's row y. The cost of right pixel xr at candidate k is the left cost of
-    x = xr + dmin + nd - 1 - k, which _keep_costs put at skew[x + k, k]: right pixel xr's
-    costs are the one row skew[xr + dmin + nd - 1] (top where that x has no cost: outside the
-    outputs' columns, or its right window outside the image)."""
+    x = xr + dmin + nd - 1 - k (top where that x has no cost: outside the outputs' columns,
+    or its right window outside the image); _keep_costs folded the row's costs into each
+    right pixel's minimum and its smallest k (rc.low / rc.at at xr + dmin + nd - 1),
+    and kept them (rc.costs[x + 1]) for the winner's two neighbours. Leaves rc.low at
+    top for the next row."""
     for xr in range(w):
-        c = skew[xr + dmin + nd - 1]
-        m = top
-        for k in range(nd):
-            m = min(m, c[k])
+        i = xr + dmin + nd - 1
+        m = rc.low[i]
         if m == top:
             continue
-        k = 0
-        while c[k] != m:
-            k += 1
-        off, _ = _decide(c, k, 0, nd, 0.0, fit)
+        k = rc.at[i]
+        off = 0.0
+        if fit != FIT_NONE and 0 < k < nd - 1:
+            x = i - k  # the winner's left pixel; candidate k - 1 is x + 1's, k + 1 is x - 1's
+            off = fit_offset(np.float32(rc.costs[x + 2, k - 1]), np.float32(m),
+                             np.float32(rc.costs[x, k + 1]), fit)
         disp_r[y, xr] = dmin + nd - 1 - k - off
+    rc.low[:] = top
 
 
 @njit(cache=True, parallel=True, fastmath=True)
@@ -319,15 +346,19 @@ def match_sad(left, right, dmin, nd, half, uniqueness, fit, want_right, clip, co
         idx = np.minimum(np.arange(ndp + 1), nd).astype(wdt)
         efloor = floor.copy()
         eidx = idx.copy()
-        # the costs the right map reads, skewed (_keep_costs); written at the same places in
-        # every row, and never where a candidate has no cost, so top there stays
-        skew = np.full((w + dmin + nd - 1 if want_right else 1, nd), top, dtype=wdt)
+        # what the right map reads (_keep_costs, _right_row): the costs are written at the
+        # same places in every row, and never where a candidate has no cost, so top there
+        # stays; the running minima start each row at top
+        wr = w if want_right else 0
+        nr = wr + dmin + nd - 1 if want_right else 1
+        rc = RightCosts(np.full((wr + 2, nd), top, dtype=wdt), np.full(nr, top, dtype=wdt),
+                        np.zeros(nr, dtype=wdt))
         for yy in range(y0 - half, y0 + half + 1):
             _cols_add(col, left_p, right_p, yy, 0, w, base0, ndc)
         for y in range(y0, y1):
             yi = y - ro  # image row
             if y == y0:
-                _row_outputs(col, win, zero, floor, idx, efloor, eidx, skew, disp_l, yi,
+                _row_outputs(col, win, zero, floor, idx, efloor, eidx, rc, disp_l, yi,
                              x_start, x_end, x_start, half, w, dmin, nd, uniqueness, fit,
                              want_right)
             else:
@@ -338,10 +369,10 @@ def match_sad(left, right, dmin, nd, half, uniqueness, fit, want_right, clip, co
                                 ndc)
                     upto = x_end if tx1 == w else min(x_end, tx1 - half)
                     if upto > done:
-                        _row_outputs(col, win, zero, floor, idx, efloor, eidx, skew,
+                        _row_outputs(col, win, zero, floor, idx, efloor, eidx, rc,
                                      disp_l, yi, done, upto, x_start, half, w, dmin, nd,
                                      uniqueness, fit, want_right)
                         done = upto
             if want_right:
-                _right_row(skew, disp_r, yi, w, dmin, nd, top, fit)
+                _right_row(rc, disp_r, yi, w, dmin, nd, top, fit)
     return disp_l, disp_r
