@@ -62,6 +62,7 @@ def _servo_sim() -> None:
     """The simulated servo's own kernels: a lensed view of the default world drawn (marker
     coverage, the lens's redraw boxes) in grey and in colour, and the marker searched in it
     (specks, centroid, ring and disc), so the first `host servo --sim` does not compile them."""
+    from host.servo.inputs import _row_mode
     from host.servo.marker import find_discs
     from host.sim.faults import CameraFaults
     from host.sim.renderer import Renderer
@@ -72,6 +73,8 @@ def _servo_sim() -> None:
         frame = Renderer(world, CameraFaults(distortion=(-0.05, -0.05)), seed=0,
                          grey=grey).frame()
         find_discs(frame.left)
+    # the floor-shift check's row mode (inputs._extremes, _fullest_bin; float32 map rows)
+    _row_mode(np.linspace(3.0, 9.0, 50, dtype=np.float32))
 
 
 def warm(part: int = 0, parts: int = 1) -> int:
