@@ -114,7 +114,7 @@ from host.servo.rig import reference_image, vertical_shift_px
 from host.servo.robot_model import REACT_S, WHEELBASE_M
 from host.servo.snapshot import Observer, Snapshot, link_stats
 from host.servo.timing import FrameTiming, TimingConfig
-from host.servo.tracker import TargetTracker, TrackerConfig, with_target
+from host.servo.tracker import TargetTracker, TrackerConfig, with_replaced, with_target
 from host.stereo.matcher import compute_disparity
 from host.stereo.params import MatcherParams
 
@@ -567,6 +567,10 @@ class Servo:
             self.notes.append(f"a nearer object appeared at {target.disparity:.2f} px: "
                               f"retargeting")
             self.controller.keep_out = self._extent(object_extent(clean, target))
+            self.controller.fixed = with_replaced(  # the replaced one, if it stands: fixed
+                self.controller.fixed, clean, object_extent(clean, before), dataclasses.replace(
+                    self.geometry, cy=(self._lane_geometry.cy + 0.5) * self._lane_scale - 0.5),
+                camera_height_m=self.camera_height_m, cell_m=self.control.cell_m)
         self.controller.target_m = self.geometry.depth_m(aligned_disparity(
             frame.left, frame.right, clean, target.bbox, target.disparity, hide=hide))
 
