@@ -119,6 +119,14 @@ class ControlConfig:
     # within 3 cm of its lane); taken only where it leaves the lane on the same side (lane)
     spread_room_m: float = 0.03
     cell_m: float = 0.02  # the fixed objects' floor cells (perception.fixed_cells)
+    # the target's own fixed cells (others leaves them out) are those across its keep-out from
+    # the camera to this far behind its face, not at any depth: its face's cells spread a cell
+    # or two about it (1.19-1.21 m for seed 3's face at 1.20 m), a face at 3 m reads about 9
+    # cm off at 0.25 px, and its depth is re-measured while its cells are the reference's (a
+    # push moves it by cm). Cells farther behind in its band are another thing's: the back
+    # wall at 3.2 m behind the target was no obstacle to a robot standing by it in the band,
+    # probing or backing away from the camera (issue 23)
+    own_depth_m: float = 0.15
     push_horizon_s: float = 3.0  # standing, a sideways drift that would bring the body onto
     # the object within this long ends the run (it cannot move sideways in place)
     drift_s: float = 3.0  # the sideways drift beside the object is fitted over this long
@@ -236,13 +244,17 @@ class Controller:
     # ------------------------------------------------------------------------- update
 
     def others(self) -> np.ndarray:
-        """The fixed objects' cells but for the target's own (its extent is the keep-out)."""
+        """The fixed objects' cells but for the target's own: across its extent (the
+        keep-out), nearer the camera than own_depth_m behind its face. Farther behind, in its
+        band, they are another thing's (the back wall) and stay."""
         cells = self.fixed
         if not len(cells) or self.keep_out is None:
             return cells
         x0, x1 = self.keep_out
         c = self.cfg.cell_m
-        return cells[~((cells[:, 1] > x0 - c) & (cells[:, 1] < x1 + c))]
+        own = ((cells[:, 1] > x0 - c) & (cells[:, 1] < x1 + c)
+               & (cells[:, 0] < self.target_m + self.cfg.own_depth_m))
+        return cells[~own]
 
     def ahead(self, depth_m: float) -> np.ndarray:
         """The other fixed objects' cells in the robot's path from depth_m to the target (to
