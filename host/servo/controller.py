@@ -203,6 +203,9 @@ class Controller:
         # fixed_cells): the lane keeps clear of those between the robot and the target, and a
         # turn in place of all of them
         self.fixed: np.ndarray = np.zeros((0, 2))
+        # cells never taken for the target's own, wherever the keep-out lies: the face of a
+        # target a nearer object replaced while it still stands (tracker.with_replaced)
+        self.kept: np.ndarray = np.zeros((0, 2))
         # where the robot stood when the reference was taken (its own body is in it), once known
         self.home: tuple[float, float] | None = None
         self._beside: list[tuple[float, float]] = []  # (t, lateral) seen near the target depth
@@ -246,15 +249,16 @@ class Controller:
     def others(self) -> np.ndarray:
         """The fixed objects' cells but for the target's own: across its extent (the
         keep-out), nearer the camera than own_depth_m behind its face. Farther behind, in its
-        band, they are another thing's (the back wall) and stay."""
+        band, they are another thing's (the back wall) and stay; the kept cells (a replaced
+        target's face) stay wherever they are: the new target may stand in front of it."""
         cells = self.fixed
-        if not len(cells) or self.keep_out is None:
-            return cells
-        x0, x1 = self.keep_out
-        c = self.cfg.cell_m
-        own = ((cells[:, 1] > x0 - c) & (cells[:, 1] < x1 + c)
-               & (cells[:, 0] < self.target_m + self.cfg.own_depth_m))
-        return cells[~own]
+        if len(cells) and self.keep_out is not None:
+            x0, x1 = self.keep_out
+            c = self.cfg.cell_m
+            own = ((cells[:, 1] > x0 - c) & (cells[:, 1] < x1 + c)
+                   & (cells[:, 0] < self.target_m + self.cfg.own_depth_m))
+            cells = cells[~own]
+        return np.concatenate([cells.reshape(-1, 2), self.kept]) if len(self.kept) else cells
 
     def ahead(self, depth_m: float) -> np.ndarray:
         """The other fixed objects' cells in the robot's path from depth_m to the target (to

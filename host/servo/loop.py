@@ -567,8 +567,8 @@ class Servo:
             self.notes.append(f"a nearer object appeared at {target.disparity:.2f} px: "
                               f"retargeting")
             self.controller.keep_out = self._extent(object_extent(clean, target))
-            self.controller.fixed = with_replaced(  # the replaced one, if it stands: fixed
-                self.controller.fixed, clean, object_extent(clean, before), dataclasses.replace(
+            self.controller.kept = with_replaced(  # the replaced one, if it stands: fixed
+                self.controller.kept, clean, object_extent(clean, before), dataclasses.replace(
                     self.geometry, cy=(self._lane_geometry.cy + 0.5) * self._lane_scale - 0.5),
                 camera_height_m=self.camera_height_m, cell_m=self.control.cell_m)
         self.controller.target_m = self.geometry.depth_m(aligned_disparity(
@@ -1197,7 +1197,7 @@ class Servo:
         c = Controller(old.target_m, self.control)
         c.cfg, c.keep_out, c.trim, c.facing_away = old.cfg, old.keep_out, old.trim, \
             old.facing_away
-        c.fixed = old.fixed
+        c.fixed, c.kept = old.fixed, old.kept
         self.controller = c
         self._cmd = Command(0, 0, Phase.WAIT, None)
         # the drives, turns and losses before it belong to a heading the probe sets afresh
