@@ -188,13 +188,16 @@ class State(ctypes.Structure):
 
 _lib: ctypes.CDLL | None = None
 _tried = False
+_failed: BuildFailed | None = None  # a build that failed fails every call, not the first only
 
 
 def library() -> ctypes.CDLL | None:
     """The compiled run_ms (built once into the user cache, keyed by its source), or None
     where it cannot be built (no gcc) or STEREO_SERVO_NO_FAST_MS is set: the caller's Python
     loop then runs, the same steps. Code of ours that does not compile is BuildFailed."""
-    global _lib, _tried
+    global _lib, _tried, _failed
+    if _failed is not None:
+        raise _failed
     if _tried:
         return _lib
     _tried = True
@@ -213,7 +216,8 @@ def library() -> ctypes.CDLL | None:
                            capture_output=True, text=True)
         src.unlink()
         if r.returncode:
-            raise BuildFailed(f"building the compiled millisecond failed: {r.stderr[:300]}")
+            _failed = BuildFailed(f"building the compiled millisecond failed: {r.stderr[:300]}")
+            raise _failed
         os.replace(tmp, lib)
     _lib = ctypes.CDLL(str(Path(lib)))
     _lib.run_ms.argtypes = [ctypes.POINTER(State), ctypes.c_int64, ctypes.c_int64,

@@ -45,7 +45,7 @@ class _Compiled:
         self.reason = ctypes.c_int32()
         self.reason_ref = ctypes.byref(self.reason)
         self.run = lib.run_ms
-        self.txbuf = ctypes.create_string_buffer(4096)
+        self.txbuf = ctypes.create_string_buffer(len(parts.core._buf))  # as the core's own
         core_lib = parts.core._lib
         self._draws = w.rng.bit_generator.ctypes  # kept alive with the pointers taken from it
 
