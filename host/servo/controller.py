@@ -199,6 +199,10 @@ class Controller:
         self.floor = config.min_duty
         self.lateral_ref: float | None = None  # the lane the robot holds (m)
         self.keep_out: tuple[float, float] | None = None  # the object's lateral extent (m)
+        # the depths (m) of the re-measure's readings the target's median is made of: a move
+        # shows in one reading before the median follows it (seed 16 #507), so a turn's circle
+        # clears the object at each of them (sweeps)
+        self.readings_m: tuple[float, ...] = ()
         # the floor cells (depth, lateral; m) of the scene's fixed objects (perception.
         # fixed_cells): the lane keeps clear of those between the robot and the target, and a
         # turn in place of all of them
@@ -317,13 +321,16 @@ class Controller:
         robot's centre is as near as one in its path), but not a body standing there
         (obstacles: the sighting is then of a look-alike). aged: the object's depth is too old
         to trust (not measured again through a search; it may have moved beside the robot
-        unseen, seed 13's trial 742): its extent across is swept at any depth. slack_m: room
-        asked beyond that (a turn's wander, turn_tight)."""
+        unseen, seed 13's trial 742): its extent across is swept at any depth. The object's
+        extent is swept at its depth and at each reading's (readings_m: moved, it may stand
+        where one reading put it). slack_m: room asked beyond that (a turn's wander,
+        turn_tight)."""
         if lateral_m is None:
             return False
         cfg = self.cfg
         reach = cfg.turn_radius_m + cfg.block_margin_m + slack_m
-        if (aged or abs(depth_m - self.target_m) < reach) and self.overlaps(
+        near = any(abs(depth_m - z) < reach for z in (self.target_m, *self.readings_m))
+        if (aged or near) and self.overlaps(
                 lateral_m, reach - cfg.half_width_m):
             return True
         return in_the_way(self.obstacles(depth_m, lateral_m), depth_m, lateral_m, None, 0.0,

@@ -573,6 +573,8 @@ class Servo:
                 camera_height_m=self.camera_height_m, cell_m=self.control.cell_m)
         self.controller.target_m = self.geometry.depth_m(aligned_disparity(
             frame.left, frame.right, clean, target.bbox, target.disparity, hide=hide))
+        self.controller.readings_m = tuple(  # a move not yet in the median (seed 16 #507)
+            self.geometry.depth_m(d) for d in self.tracker.history)
 
     def _lane_follows(self, clean: np.ndarray, target: Target) -> None:
         """The lane's reference with the target where the re-measure found it (tracker's
