@@ -1195,7 +1195,9 @@ class Servo:
                                        facing_away=None if probe or not proven
                                        else old.facing_away,
                                        again=why,
-                                       spent_s=0.0 if proven else self.acquisition.driven_s())
+                                       spent_s=0.0 if proven else self.acquisition.driven_s(),
+                                       one_way=(0.0, 0) if proven
+                                       else self.acquisition.one_way)
         c = Controller(old.target_m, self.control)
         c.cfg, c.keep_out, c.trim, c.facing_away = old.cfg, old.keep_out, old.trim, \
             old.facing_away
