@@ -199,10 +199,6 @@ class Controller:
         self.floor = config.min_duty
         self.lateral_ref: float | None = None  # the lane the robot holds (m)
         self.keep_out: tuple[float, float] | None = None  # the object's lateral extent (m)
-        # how far the body may be turned off the camera axis (rad: the learnt heading's angle
-        # off it plus its spread, set by the loop), None not known: a turned body reaches
-        # farther across x than half its width (seed 16 #470: 29 degrees, 10.8 cm for 8)
-        self.turned_by: float | None = None
         # the floor cells (depth, lateral; m) of the scene's fixed objects (perception.
         # fixed_cells): the lane keeps clear of those between the robot and the target, and a
         # turn in place of all of them
@@ -372,7 +368,7 @@ class Controller:
         if self.overlaps(lateral, cfg.block_margin_m):
             return True
         x0, x1 = self.keep_out
-        reach = self.across_m() + cfg.block_margin_m
+        reach = cfg.half_width_m + cfg.block_margin_m
         gap = lateral - reach - x1 if lateral > x1 else x0 - reach - lateral
         toward = -rate if lateral > x1 else rate
         horizon = cfg.push_horizon_s if seen else cfg.unseen_horizon_s
@@ -384,18 +380,8 @@ class Controller:
         if lateral is None or self.keep_out is None:
             return False
         x0, x1 = self.keep_out
-        reach = self.across_m() + margin
+        reach = self.cfg.half_width_m + margin
         return x0 - reach < lateral < x1 + reach
-
-    def across_m(self) -> float:
-        """Half the body's extent across x (m): half its width, or the rectangle's reach
-        turned by turned_by (at most a quarter turn), whichever is more."""
-        cfg, a = self.cfg, self.turned_by
-        if a is None:
-            return cfg.half_width_m
-        a = min(abs(a), math.pi / 2)
-        return max(cfg.half_width_m,
-                   cfg.half_width_m * math.cos(a) + cfg.half_length_m * math.sin(a))
 
     def update(self, obs: Observation) -> Command:
         self.turned_half = None

@@ -1373,9 +1373,6 @@ class Servo:
             g = self.geometry
             self.heading.update(t, s.z, s.x, self._cmd.left, self._cmd.right, depth_noise_m(
                 s.z, self.estimator.sigma_px, g.focal_px, g.baseline_m))
-        h = self.heading.value  # the body's turn off the camera axis, for the block checks
-        c.turned_by = None if h is None else (
-            abs(math.remainder(h, math.pi)) + self.heading.spread)
         if c.turned_half is not None:  # a turn round witnessed half a turn (controller.py)
             self.heading.turned_round(c.turned_half)  # the way shown before it, reversed
         if not self._cmd.is_stop:
