@@ -14,38 +14,16 @@ from collections.abc import Callable
 
 from host.servo.acquire import AcquireConfig, Acquisition
 from host.servo.phase import Phase
+from tests.servo.probe_drive import run_probe
 
-DT = 0.066
-FB = 25.8  # focal length times baseline (px m), as the trials' 320x240 rig
 Z0 = 2.45  # far: a move of a few cm within the noise (seed 15's trial 839)
 
 
 def _run(acq: Acquisition, z: float = Z0, shows: float = 0.7, cut_s: float = 1.2,
          stale_s: float = 0.3, speed: float = 0.15,
          until: Callable[[Acquisition], bool] | None = None) -> list[float]:
-    """A robot facing away at z (m), moving speed (m/s per 1000 of duty, its wheels a frame
-    late); its sightings show the fraction shows of its move from Z0, 5 cm short. The probe
-    backs it; cut_s after the probe began, stale frames for stale_s start it again. Until the
-    acquisition ends (or until(acq)): the robot's true depths, its start's first."""
-    t, left = 0.0, 0
-    truth: list[float] = [z]
-    began: float | None = None
-    while not acq.done and not acq.fault and t < 14.0 and not (until and until(acq)):
-        t += DT
-        z += speed * left / 1000 * DT
-        truth.append(z)
-        if acq.phase == Phase.PROBE and began is None:
-            began = t
-        if began is not None and began + cut_s <= t < began + cut_s + stale_s:
-            acq.interrupted(t)  # the loop sends a stop (STALE)
-            left = 0
-            continue
-        seen = Z0 + shows * (z - Z0) - 0.05
-        order = acq.update(t, (seen, 0.0), FB / seen, 0.01)
-        if acq.phase == Phase.MEASURE:
-            acq.direction = -1
-        left = order.left
-    return truth
+    """run_probe with the sightings' move counted from Z0, the first acquisition's start."""
+    return run_probe(acq, z, shows, cut_s, stale_s, speed, until, z_ref=Z0)
 
 
 def _beyond_and_reach(truth: list[float], start: float) -> tuple[float, float]:

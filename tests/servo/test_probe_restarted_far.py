@@ -11,38 +11,16 @@ now does the same. Near, where probe_m is beyond three of the noise, the stop st
 from __future__ import annotations
 
 from host.servo.acquire import NOT_MOVED, PROBED_OUT, AcquireConfig, Acquisition
-from host.servo.phase import Phase
-
-DT = 0.066
-FB = 25.8  # focal length times baseline (px m), as the trials' 320x240 rig
+from tests.servo.probe_drive import run_probe
 
 
 def _restarted(z0: float, shows: float, cut_s: float = 1.2, stale_s: float = 0.3,
                speed: float = 0.15, t_end: float = 14.0) -> tuple[Acquisition, list[float]]:
-    """A robot facing away at z0 (m), moving speed (m/s per 1000 of duty, its wheels a frame
-    late); its sightings show the fraction shows of its move from its start, 5 cm short. The
-    probe backs it (the target nearer the camera); cut_s after the probe began, stale frames
-    for stale_s start it again."""
+    """A robot facing away at z0 (m), its sightings the fraction shows of its move, 5 cm short;
+    the probe backs it (the target nearer the camera), a stale stretch starts it again
+    (probe_drive.run_probe)."""
     acq = Acquisition(AcquireConfig())
-    t, z, left = 0.0, z0, 0
-    truth: list[float] = []
-    began: float | None = None
-    while not acq.done and not acq.fault and t < t_end:
-        t += DT
-        z += speed * left / 1000 * DT
-        truth.append(z)
-        if acq.phase == Phase.PROBE and began is None:
-            began = t
-        if began is not None and began + cut_s <= t < began + cut_s + stale_s:
-            acq.interrupted(t)  # the loop sends a stop (STALE)
-            left = 0
-            continue
-        seen = z0 + shows * (z - z0) - 0.05
-        order = acq.update(t, (seen, 0.0), FB / seen, 0.01)
-        if acq.phase == Phase.MEASURE:
-            acq.direction = -1
-        left = order.left
-    return acq, truth
+    return acq, run_probe(acq, z0, shows, cut_s, stale_s, speed, t_end=t_end)
 
 
 def test_a_far_restarted_probe_within_the_noise_takes_its_second_leg() -> None:
