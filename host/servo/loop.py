@@ -571,13 +571,19 @@ class Servo:
                               f"retargeting")
             self.controller.keep_out = self._extent(object_extent(clean, target))
             self.controller.kept = with_replaced(  # the replaced one, if it stands: fixed
-                self.controller.kept, clean, object_extent(clean, before), dataclasses.replace(
-                    self.geometry, cy=(self._lane_geometry.cy + 0.5) * self._lane_scale - 0.5),
-                camera_height_m=self.camera_height_m, cell_m=self.control.cell_m)
+                self.controller.kept, clean, object_extent(clean, before),
+                self._horizon_geometry(), camera_height_m=self.camera_height_m,
+                cell_m=self.control.cell_m)
         self.controller.target_m = self.geometry.depth_m(aligned_disparity(
             frame.left, frame.right, clean, target.bbox, target.disparity, hide=hide))
         self.controller.readings_m = tuple(  # a move not yet in the median (seed 16 #507)
             self.geometry.depth_m(d) for d in self.tracker.history)
+
+    def _horizon_geometry(self) -> Geometry:
+        """The full-size geometry with its horizon where the lane's is (a re-reference after
+        a knock moves it): the fixed objects' cells of a map taken since."""
+        return dataclasses.replace(
+            self.geometry, cy=(self._lane_geometry.cy + 0.5) * self._lane_scale - 0.5)
 
     def _lane_follows(self, clean: np.ndarray, target: Target) -> None:
         """The lane's reference with the target where the re-measure found it (tracker's
@@ -1324,10 +1330,9 @@ class Servo:
         self.controller.target_m = self.geometry.depth_m(target.disparity)
         self.controller.keep_out = self._extent(
             object_extent(without_floor(reference, floor), target))
-        g = self.geometry
         self.controller.fixed = fixed_cells(
-            reference, dataclasses.replace(g, cy=(lane.cy + 0.5) * k - 0.5),
-            camera_height_m=self.camera_height_m, cell_m=self.control.cell_m)
+            reference, self._horizon_geometry(), camera_height_m=self.camera_height_m,
+            cell_m=self.control.cell_m)
         assert self._strips is not None
         self._strips.reset()
         self._remeasure_t = None
