@@ -97,6 +97,9 @@ class AcquireConfig:
     spin_drop: float = 0.1  # a card standing within a quarter of this (four of its spread),
     # seen through the turn, whose width-to-height ratio then fell under half of it, did not
     # turn with the robot (~30 degrees: 0.13): a look-alike's; else the refusal stands
+    settle_s: float = 0.7  # a probe refused by a fixed object stands this long (its
+    # run-down and the standing estimate's settling) before it is checked again (pause)
+    pause_s: float = 1.5  # and at most this long: still refused, the refusal stands
     back_factor: float = 2.0  # the second leg's time at each of the first's duties, of the
     # first's (back through the start and as far beyond it: the robot stays within the first
     # leg's reach of it, as the first leg's own time at each duty sets its travel)
@@ -151,6 +154,8 @@ class Acquisition:
         self._spin_t0: float | None = None
         self._turned: list[float] = []  # the card's ratios while the robot turns
         self._spin_stood: float | None = None  # the spin test interrupted at (standing since)
+        self.paused_t: float | None = None  # a refused probe standing since (pause)
+        self._paused = False  # it stood once (once an acquisition)
         self._spin_cut = False  # the spin test was interrupted: it shows no look-alike
         self.spent_s = spent_s  # the probe's driving before its last start (s)
         self._spent0 = spent_s  # of it, an earlier acquisition's: not in this one's ledger
@@ -202,9 +207,33 @@ class Acquisition:
             return Order(0, 0, Phase.MEASURE)
         if self.phase == Phase.PROBE and self._spin_why:
             return self._spin_test(t, aspect if position is not None else None)
+        if self.phase == Phase.PROBE and self.paused_t is not None:
+            return Order(0, 0, Phase.PROBE)  # stands; its sightings are not the probe's
         if self.phase == Phase.PROBE:
             return self._probe(t, position, disparity, noise_m)
         return Order(0, 0, Phase.DONE)
+
+    def pause(self, t: float) -> bool:
+        """The probe, its facing unshown, refused by a fixed object at t (the robot stands this
+        frame, as the run's stop would have it): once an acquisition, it stands instead of
+        ending the run, and the servo checks its next move again on the standing estimate
+        (the refusal came on an estimate that followed the probe's command: at 3 m a sighting
+        jumps 3-8 cm for frames on end, and the driven filter follows it with a rate, seed 16
+        #399: 2.96 -> 3.01 m and +0.14 m/s while the robot stood at 2.99 m and then went the
+        other way): resume() when that check passes, else the refusal stands. Its clock and
+        ledger stop meanwhile (the stand is a gap in its track: _probe's gap rule counts the
+        stand's first run_down_s as driven). False: it stood once already, or is in its spin
+        test or standing after: the refusal stands."""
+        if self.phase != Phase.PROBE or self.facing_away is not None or self._paused \
+                or self._spin_why or self._after is not None:
+            return False
+        self._ledger_drive(t)
+        self._paused, self.paused_t = True, t
+        return True
+
+    def resume(self) -> None:
+        """The pause is over (the move checked again and clear, or the refusal stands)."""
+        self.paused_t = None
 
     def refused(self, why: str) -> bool:
         """The probe's first leg, its facing unshown, refused by a fixed object one way or the

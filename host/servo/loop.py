@@ -298,6 +298,7 @@ class Servo:
         # in m): the re-acquisition's probe does not drive on a sighting beyond it unshown
         self._outside_zone: tuple[float, float, float] | None = None
         self._still_since: float | None = None  # standing since (the drift check)
+        self._pause_why = ""  # the probe's refusal it stands on (Acquisition.pause)
         self._width = 0
         self.recovery = Recovery(servo_bounds(self.cfg.recover, self.cfg.rereference,
                                               self.cfg.lane_stop_s))
@@ -1383,6 +1384,13 @@ class Servo:
         fault = self._path_fault(frame, cmd) if moving else self._spin_fault(frame.t_left, cmd)
         if moving and cmd.left * cmd.right < 0:  # the probe's spin test: a spin, checked as
             fault = fault or self._spin_fault(frame.t_left, cmd)  # one (sweeps, aged depth)
+        if self.acquisition.paused_t is not None:
+            stand, fault = self._probe_paused(frame, t, cmd, fault)
+            if stand:
+                return Command(0, 0, Phase.PROBE, cmd.error_m), invalid or stand
+        elif fault.startswith(INTO_FIXED.format("probe")) and self.acquisition.pause(t):
+            self._pause_why = fault  # it stands, and its move is checked again (acquire.py)
+            return Command(0, 0, Phase.PROBE, cmd.error_m), invalid or f"standing: {fault}"
         if fault.startswith(INTO_FIXED.format("probe")) and self.acquisition.refused(fault):
             return Command(0, 0, Phase.PROBE, cmd.error_m), invalid  # a spin test first
         rec, b = self.recovery, self.backoff
@@ -1416,6 +1424,29 @@ class Servo:
             return cmd, invalid or blocked
         self.controller.phase = Phase.OBSTACLE
         return Command(0, 0, Phase.OBSTACLE, cmd.error_m), invalid or blocked
+
+    def _probe_paused(self, frame: StereoFrame, t: float, cmd: Command, fault: str
+                      ) -> tuple[str, str]:
+        """A frame of the refused probe's stand (Acquisition.pause): once it has stood
+        settle_s, its move is checked again, every check a probe frame has (_path_fault, both
+        ways while its facing is unshown), at the probe's top duty, on the standing estimate;
+        clear: it drives on from the next frame, each frame checked as ever; still refused at
+        pause_s: the refusal stands (the spin test, or the run ends, as before). Why it stands
+        this frame ("": it does not), and the fault to go on with."""
+        acq = self.acquisition
+        assert acq.paused_t is not None
+        stood = t - acq.paused_t
+        if fault or stood < acq.cfg.settle_s:  # a standing check's fault ends the run
+            return ("" if fault else f"standing: {self._pause_why}"), fault
+        duty = acq.cfg.max_probe_duty * acq.direction
+        why = self._path_fault(frame, Command(duty, duty, Phase.PROBE, cmd.error_m))
+        if not why:
+            acq.resume()  # checked again and clear: it drives on from the next frame
+            return f"standing: {self._pause_why}", ""
+        if stood < acq.cfg.pause_s:
+            return f"standing: {why}", ""
+        acq.resume()
+        return "", why  # the refusal stands
 
     def _track_heading(self, t: float, cmd: Command) -> None:
         """The heading from the travel under the command in force; how long the robot has
