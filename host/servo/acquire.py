@@ -155,7 +155,7 @@ class Acquisition:
         self._turned: list[float] = []  # the card's ratios while the robot turns
         self._spin_stood: float | None = None  # the spin test interrupted at (standing since)
         self.paused_t: float | None = None  # a refused probe standing since (pause)
-        self._paused = False  # it stood once (once an acquisition)
+        self._paused_leg = 0  # the leg it last stood in (once a leg)
         self._spin_cut = False  # the spin test was interrupted: it shows no look-alike
         self.spent_s = spent_s  # the probe's driving before its last start (s)
         self._spent0 = spent_s  # of it, an earlier acquisition's: not in this one's ledger
@@ -215,20 +215,22 @@ class Acquisition:
 
     def pause(self, t: float) -> bool:
         """The probe, its facing unshown, refused by a fixed object at t (the robot stands this
-        frame, as the run's stop would have it): once an acquisition, it stands instead of
+        frame, as the run's stop would have it): once a leg, it stands instead of
         ending the run, and the servo checks its next move again on the standing estimate
         (the refusal came on an estimate that followed the probe's command: at 3 m a sighting
         jumps 3-8 cm for frames on end, and the driven filter follows it with a rate, seed 16
         #399: 2.96 -> 3.01 m and +0.14 m/s while the robot stood at 2.99 m and then went the
         other way): resume() when that check passes, else the refusal stands. Its clock and
         ledger stop meanwhile (the stand is a gap in its track: _probe's gap rule counts the
-        stand's first run_down_s as driven). False: it stood once already, or is in its spin
-        test or standing after: the refusal stands."""
-        if self.phase != Phase.PROBE or self.facing_away is not None or self._paused \
-                or self._spin_why or self._after is not None:
+        stand's first run_down_s as driven). False: it stood once already in this leg, or is
+        in its spin test or standing after: the refusal stands (seed 16 #438: its first leg
+        stood at the start, its second, back through the start, was refused 0.5 cm short of
+        it with the estimate 6 cm beyond the truth)."""
+        if self.phase != Phase.PROBE or self.facing_away is not None \
+                or self._paused_leg == self._leg or self._spin_why or self._after is not None:
             return False
         self._ledger_drive(t)
-        self._paused, self.paused_t = True, t
+        self._paused_leg, self.paused_t = self._leg, t
         return True
 
     def resume(self) -> None:
