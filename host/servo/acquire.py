@@ -213,7 +213,7 @@ class Acquisition:
             return self._probe(t, position, disparity, noise_m)
         return Order(0, 0, Phase.DONE)
 
-    def pause(self, t: float) -> bool:
+    def pause(self, t: float, noise_m: float) -> bool:
         """The probe, its facing unshown, refused by a fixed object at t (the robot stands this
         frame, as the run's stop would have it): once a leg, it stands instead of
         ending the run, and the servo checks its next move again on the standing estimate
@@ -222,12 +222,17 @@ class Acquisition:
         #399: 2.96 -> 3.01 m and +0.14 m/s while the robot stood at 2.99 m and then went the
         other way): resume() when that check passes, else the refusal stands. Its clock and
         ledger stop meanwhile (the stand is a gap in its track: _probe's gap rule counts the
-        stand's first run_down_s as driven). False: it stood once already in this leg, or is
-        in its spin test or standing after: the refusal stands (seed 16 #438: its first leg
-        stood at the start, its second, back through the start, was refused 0.5 cm short of
-        it with the estimate 6 cm beyond the truth)."""
+        stand's first run_down_s as driven). noise_m: a sighting's depth noise where the robot
+        is (m): only far away (three of it beyond still_factor probe_m, as _within_noise) does
+        the standing estimate differ from the driven one (near, dev seed 105 #1's look-alike at
+        1.57 m stood 1.5 s refused throughout, and the run, shifted against the scene's
+        events, ended on a later drive's stop). False: near, it stood once already in this
+        leg, or is in its spin test or standing after: the refusal stands (seed 16 #438: its
+        first leg stood at the start, its second, back through the start, was refused 0.5 cm
+        short of it with the estimate 6 cm beyond the truth)."""
         if self.phase != Phase.PROBE or self.facing_away is not None \
-                or self._paused_leg == self._leg or self._spin_why or self._after is not None:
+                or self._paused_leg == self._leg or self._spin_why or self._after is not None \
+                or 3 * noise_m <= self.cfg.still_factor * self.cfg.probe_m:
             return False
         self._ledger_drive(t)
         self._paused_leg, self.paused_t = self._leg, t

@@ -1388,7 +1388,8 @@ class Servo:
             stand, fault = self._probe_paused(frame, t, cmd, fault)
             if stand:
                 return Command(0, 0, Phase.PROBE, cmd.error_m), invalid or stand
-        elif fault.startswith(INTO_FIXED.format("probe")) and self.acquisition.pause(t):
+        elif fault.startswith(INTO_FIXED.format("probe")) and self.acquisition.pause(
+                t, self._sighting_noise_m()):
             self._pause_why = fault  # it stands, and its move is checked again (acquire.py)
             return Command(0, 0, Phase.PROBE, cmd.error_m), invalid or f"standing: {fault}"
         if fault.startswith(INTO_FIXED.format("probe")) and self.acquisition.refused(fault):
@@ -1424,6 +1425,16 @@ class Servo:
             return cmd, invalid or blocked
         self.controller.phase = Phase.OBSTACLE
         return Command(0, 0, Phase.OBSTACLE, cmd.error_m), invalid or blocked
+
+    def _sighting_noise_m(self) -> float:
+        """A sighting's depth noise where the robot is estimated (m): the measure's disparity
+        noise, at least the acquisition's floor_px (far sightings err together), or 0.0
+        without an estimate."""
+        s, g = self.estimator.state, self.geometry
+        if s is None:
+            return 0.0
+        sd = max(self.estimator.sigma_px, self.acquisition.cfg.floor_px)
+        return depth_noise_m(s.z, sd, g.focal_px, g.baseline_m)
 
     def _probe_paused(self, frame: StereoFrame, t: float, cmd: Command, fault: str
                       ) -> tuple[str, str]:

@@ -6,7 +6,8 @@ robot stood at 2.99 m). The run used to end on that one refusal; now the robot s
 (Acquisition.pause: the probe's clock and ledger stop), its next move is checked again, every
 check a probe frame has, at the probe's top duty, on the standing estimate after settle_s:
 clear, the probe goes on (each frame checked as ever); still refused at pause_s, or refused a
-second time in the same leg, the refusal stands as before. No check is changed: what is sent is checked."""
+second time in the same leg, the refusal stands as before; near (a sighting's noise small) it
+stands at once, as before. No check is changed: what is sent is checked."""
 
 from __future__ import annotations
 
@@ -72,6 +73,18 @@ def test_a_refused_probe_stands_and_goes_on_once_its_move_is_clear(
         assert scene.stop_reason.startswith(INTO_FIXED.format("probe")), scene.stop_reason
 
 
+def test_a_near_refused_probe_ends_the_run_at_once(scene: Servo) -> None:  # noqa: F811
+    """Near (1.5 m, a sighting's noise 1 cm at the floor's 0.1 px) the standing estimate is the
+    driven one: the refusal stands at once, as before. The box at 1.8 m leaves cells at
+    1.79-1.81 m, 0.23-0.55 m right: the robot at 1.62 m, 0.32 m right, its first leg's other
+    way runs onto them."""
+    with _probing(scene) as acq:
+        t = 30.0
+        cmd, why = _watch(_at(scene, 1.62, 0.32, None, t=t), t, LEG1)
+        assert scene.stop_reason.startswith(INTO_FIXED.format("probe")), scene.stop_reason
+        assert acq.paused_t is None
+
+
 def test_a_probe_still_refused_standing_ends_the_run_as_before(
         scene: Servo) -> None:  # noqa: F811
     """The standing estimate stays where the move is refused: it stands up to pause_s, then
@@ -95,13 +108,14 @@ def test_the_pause_stops_the_probes_clock_and_ledger() -> None:
     acq.phase, acq.direction = Phase.PROBE, 1
     for k in range(8):
         acq.update(0.0625 * k, (2.9, 0.0), 8.8, 0.01)
-    assert acq.pause(0.5)
+    assert not acq.pause(0.5, 0.013)  # near (three of its noise under 4 cm): no stand
+    assert acq.pause(0.5, 0.035)
     n = len(acq._track)
     for k in range(16):
         assert acq.update(0.5625 + 0.0625 * k, (2.9, 0.0), 8.8, 0.01).left == 0
     assert len(acq._track) == n and abs(sum(acq._levels.values()) - 0.5) < 1e-9
-    assert not acq.pause(1.6)  # once a leg
+    assert not acq.pause(1.6, 0.035)  # once a leg
     acq.resume()
     assert acq.update(1.6, (2.9, 0.0), 8.8, 0.01).left > 0  # it drives on
     acq._second_leg(1.7, False)  # its second leg, back the other way, may stand once too
-    assert acq.pause(1.8) and not acq.pause(1.9)
+    assert acq.pause(1.8, 0.035) and not acq.pause(1.9, 0.035)
