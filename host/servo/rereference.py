@@ -79,6 +79,9 @@ class RereferenceLimits:
     disparity_frac: float = 0.03
     overlap: float = 0.5
     agreement: float = 0.6
+    moved_frac: float = 0.35  # of the target's disparity: the farthest a target found at its
+    # place by two tries running (rereference_fault's earlier) may have moved in depth (the
+    # tracker's TrackerConfig.same_depth: farther, and it is another object)
 
 
 def floor_follows_picture(floor_px: float, shift_rows: float, floor: Floor,
@@ -161,6 +164,7 @@ def nearest_agreeing(disp: np.ndarray, min_area: int, agreement: Callable[[Targe
 def rereference_fault(old_floor: Floor | None, floor: Floor, shift_rows: float, old: Target,
                       new: Target, agreement: float, moved_rows: float = 0.0,
                       target_rows: float | None = None, last: float | None = None,
+                      earlier: Target | None = None,
                       limits: RereferenceLimits = RereferenceLimits()) -> str:
     """Why a re-reference cannot be trusted ("" when it can): what it found (floor, the
     nearest object new, how well new's two views agree) against the old reference (old_floor,
@@ -174,7 +178,14 @@ def rereference_fault(old_floor: Floor | None, floor: Floor, shift_rows: float, 
     target_shift_rows, NaN when not found), at its disparity (old's, the median of the
     tracker's last measures, or last, the newest of them: a target that moved in depth shortly
     before the knock has been measured there once or twice, and the median lags), and
-    agreeing in both views."""
+    agreeing in both views. A target moved in depth while the camera moved (the box pushed
+    just before the knock, unmeasured over a turn, or during the wait: seed 16's trials 239,
+    420) is another disparity: one try refuses it; earlier given (the nearest object the
+    previous try of this wait found), the target's move is taken as the tracker takes an aged
+    depth's (two readings agreeing with each other): new and earlier at the same place and
+    depth (target_moved), within moved_frac of the target's disparity, every other check as
+    before (the floor, the target's own picture moved with the picture, its place, its
+    views)."""
     lim = limits
     if abs(shift_rows) < moved_rows:
         return (f"the picture did not move ({shift_rows:+.1f} rows): something stands over "
@@ -194,7 +205,8 @@ def rereference_fault(old_floor: Floor | None, floor: Floor, shift_rows: float, 
     def near(d: float) -> bool:
         return abs(new.disparity - d) <= max(lim.disparity_px, lim.disparity_frac * d)
 
-    if not (near(old.disparity) or last is not None and near(last)):
+    if not (near(old.disparity) or last is not None and near(last)
+            or target_moved(old, new, earlier, lim)):
         return (f"the nearest object is at {new.disparity:.2f} px, the target was at "
                 f"{old.disparity:.2f} px")
     ox, oy, ow, oh = old.bbox
@@ -208,6 +220,29 @@ def rereference_fault(old_floor: Floor | None, floor: Floor, shift_rows: float, 
         shown = "no texture" if math.isnan(agreement) else f"{agreement:.2f}"
         return f"the target's region does not agree in both views ({shown})"
     return ""
+
+
+def target_moved(old: Target, new: Target, earlier: Target | None,
+                 limits: RereferenceLimits = RereferenceLimits()) -> bool:
+    """Whether new, found by a re-reference at another disparity than the target old had, is
+    the target moved in depth: earlier (the previous try's find, None: no previous try)
+    found at new's disparity (within limits' disparity_px or disparity_frac) and overlapping
+    new by limits.overlap across and down (two tries running saw the same object still, not a
+    person passing, nor a phantom), and new within limits.moved_frac of old's disparity (the
+    tracker follows a move no larger). Where it stands (old's place moved by the picture) and
+    what it shows (its picture, its views) are rereference_fault's own checks."""
+    if earlier is None:
+        return False
+    lim = limits
+    d = earlier.disparity
+    if not abs(new.disparity - d) <= max(lim.disparity_px, lim.disparity_frac * d):
+        return False
+    if not abs(new.disparity - old.disparity) <= lim.moved_frac * old.disparity:
+        return False
+    ex, ey, ew, eh = earlier.bbox
+    nx, ny, nw, nh = new.bbox
+    return (span_overlap(ex, ex + ew, nx, nx + nw) >= lim.overlap
+            and span_overlap(ey, ey + eh, ny, ny + nh) >= lim.overlap)
 
 
 def fill_hidden(new: np.ndarray, old: np.ndarray, box: tuple[int, int, int, int],
