@@ -304,6 +304,7 @@ class Servo:
                                               self.cfg.lane_stop_s))
         self._reref: list[np.ndarray] = []  # the re-reference's maps so far (robot left out)
         self._reref_fails = 0  # re-references that failed, in this wait
+        self._reref_found: Target | None = None  # the nearest object the last try found
         self._targets_before: list[Target] = []  # the targets a nearer object replaced
         self.progress = Progress(self.cfg.progress)  # no progress for long: the run ends
         self.refind: Refind | None = None  # the card lost while driving, looked for (refind.py)
@@ -545,7 +546,7 @@ class Servo:
                     floor_shift_px(disp, self.floor, reference=self.reference_map), dy,
                     self.floor):  # and the picture itself moved, as far as the floor: an
                 # object put down over the floor's rows shifts their disparity too
-                self._reref, self._reref_fails = [], 0
+                self._reref, self._reref_fails, self._reref_found = [], 0, None
                 self._recover(frame.t_left, MOVED, f"{moved} (the picture moved {dy:+.1f} rows)")
                 return
             if abs(dy) < limit:
@@ -1309,14 +1310,18 @@ class Servo:
                 without_floor(reference, floor), self.tracker.min_area,
                 lambda t: views_agree(frame.left, frame.right, t.bbox, t.disparity))
         except HostError as e:
+            self._reref_found = None
             return str(e)
+        earlier, self._reref_found = self._reref_found, target  # two tries running: a
+        # target moved in depth meanwhile (rereference.target_moved)
         # the target's picture as the last re-measure saw it (the target may have moved since
         # the reference phase, the robot stand in front of it), else the reference's
         picture, hide = self._target_picture or (self._reference_image, None)
         rows = target_shift_rows(picture, frame.left, old.bbox, int(abs(dy)) + 4, hide=hide)
         why = rereference_fault(self.floor, floor, dy, old, target, agree,
                                 moved_rows=self.cfg.moved_rows * self.geometry.focal_px,
-                                target_rows=rows, last=self.tracker.history[-1])
+                                target_rows=rows, last=self.tracker.history[-1],
+                                earlier=earlier)
         if why:
             return why
         k, lane = self._lane_scale, self._lane_geometry
@@ -1339,7 +1344,10 @@ class Servo:
         self._remeasure_t = None
         self._measured_t = frame.t_left
         self.notes.append(f"re-referenced after the camera moved {dy:+.1f} rows: target at "
-                          f"{target.disparity:.2f} px")
+                          f"{target.disparity:.2f} px" + (
+                              f" (moved from {old.disparity:.2f} px, found so twice)"
+                              if earlier is not None and abs(target.disparity - old.disparity)
+                              > 0.5 else ""))
         return ""
 
     def _back_to_target(self, clean: np.ndarray, frame: StereoFrame) -> bool:
