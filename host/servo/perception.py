@@ -557,8 +557,9 @@ def in_view(u: float, v: float, ring_px: float, size: tuple[int, int], scale: fl
 # ------------------------------------------------- the calibration's leftover, by column
 
 
-BIAS_LIMIT_PX = 0.25  # a column bias this large somewhere is corrected (and said); smaller
-# ones are within what the matcher reads on the floor of a well-calibrated camera
+BIAS_LIMIT_PX = 0.3  # a column bias this large somewhere is corrected (and said); smaller
+# ones are left: seed 16's camera 11 reads +0.61/+0.68 (trials 27, 299), the 16 cameras of
+# seed 105 (one reference each) at most 0.24, seed 16's camera 5 0.15-0.17
 
 
 @dataclass(frozen=True)
