@@ -557,9 +557,11 @@ def in_view(u: float, v: float, ring_px: float, size: tuple[int, int], scale: fl
 # ------------------------------------------------- the calibration's leftover, by column
 
 
-BIAS_LIMIT_PX = 0.3  # a column bias this large somewhere is corrected (and said); smaller
-# ones are left: seed 16's camera 11 reads +0.61/+0.68 (trials 27, 299), the 16 cameras of
-# seed 105 (one reference each) at most 0.24, seed 16's camera 5 0.15-0.17
+BIAS_LIMIT_PX = 0.3  # a column bias this large somewhere is corrected (and said)
+BIAS_NOISE_PX = 0.25  # and only by what it has beyond this: the floor's leftover on cameras
+# whose calibration is right within 0.08 px reads 0.15-0.17 px (seed 16's camera 5), and
+# seed 105's cameras 0, 8, 13 read -0.4..+0.5 at the picture's two ends; seed 16's camera
+# 11 +0.61/+0.68 (trials 27, 299) at its left columns, for a true +0.7-1 px
 
 
 @dataclass(frozen=True)
@@ -571,6 +573,12 @@ class ColumnBias:
 
     excess: np.ndarray  # (w,) px, by column of the right view (smoothed; held at the ends)
     measured: int  # columns with floor enough to measure
+
+    def applied(self, noise_px: float = BIAS_NOISE_PX) -> np.ndarray:
+        """The excess trusted beyond the measure's noise: each column's shrunk toward 0 by
+        noise_px (px)."""
+        e = self.excess.astype(np.float32)
+        return np.sign(e) * np.maximum(np.abs(e) - np.float32(noise_px), np.float32(0))
 
     @property
     def largest(self) -> float:
@@ -638,13 +646,15 @@ def floor_column_bias(disp: np.ndarray, floor: Floor | None, tol_px: float = 1.0
     return ColumnBias(smooth.astype(np.float32), int(known.size))
 
 
-def corrected_right(right: np.ndarray, bias: ColumnBias) -> np.ndarray:
-    """The right view with each column's disparity excess taken out: the pixel at column x
-    taken from x - excess[x] (a view read too far left by e reads disparity e too high), so
-    every disparity matched or measured on the pair afterwards (maps, the marker, a face's
-    alignment) is the same as the bias-free pair's."""
+def corrected_right(right: np.ndarray, bias: ColumnBias, noise_px: float = BIAS_NOISE_PX
+                    ) -> np.ndarray:
+    """The right view with each column's disparity excess beyond noise_px taken out
+    (ColumnBias.applied): the pixel at column x taken from x - excess[x] (a view read too far
+    left by e reads disparity e too high), so every disparity matched or measured on the pair
+    afterwards (maps, the marker, a face's alignment) is as the bias-free pair's, within
+    noise_px."""
     h, w = right.shape[:2]
-    map_x = np.broadcast_to(np.arange(w, dtype=np.float32) - bias.excess[:w], (h, w))
+    map_x = np.broadcast_to(np.arange(w, dtype=np.float32) - bias.applied(noise_px)[:w], (h, w))
     map_y = np.broadcast_to(np.arange(h, dtype=np.float32)[:, None], (h, w))
     return cv2.remap(right, np.ascontiguousarray(map_x), np.ascontiguousarray(map_y),
                      cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
