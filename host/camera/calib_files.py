@@ -43,6 +43,9 @@ class Calibration:
     mats: dict[str, np.ndarray]  # MATRICES
     rms: float  # px, reprojection RMS of the stereo fit (NaN when not known, e.g. from ROS)
     epipolar_rms: float  # px, row difference of rectified corners
+    # what the fit's boards did not pin down (calibration.edge_problem; one line), "" when
+    # nothing or not known (a file keeps the matrices alone)
+    problem: str = ""
 
     @property
     def baseline_mm(self) -> float:

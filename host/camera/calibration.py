@@ -24,6 +24,12 @@ MIN_VIEWS = 15
 # a view is rejected when its RMS reprojection error exceeds both of these
 OUTLIER_FACTOR = 3.0  # times the median view's error
 OUTLIER_FLOOR_PX = 0.3
+# the lens model at the image's edge columns (centre row) may differ from its k1 term alone,
+# fitted where the boards' corners lie, by this much (px) when the boards do not reach there:
+# beyond their reach the higher term is extrapolated, not measured (seed 16's camera 11: the
+# right lens fitted k1 -0.052, k2 -0.339 for a true -0.092, 0, 0.55 px there; its rectified
+# disparity read 0.7-1 px high at the left columns; the other 31 lenses of seed 16: <= 0.28)
+EDGE_EXTRAPOLATION_PX = 0.4
 
 
 @dataclass(frozen=True)
@@ -42,6 +48,11 @@ class CalibrationRun:
 
     calibration: Calibration
     views: list[View] = field(default_factory=list)
+
+    @property
+    def problem(self) -> str:
+        """One line: what the boards do not pin down (edge_problem), "" if none."""
+        return self.calibration.problem
 
     def named(self, status: str) -> list[View]:
         return [v for v in self.views if v.status == status]
@@ -148,8 +159,60 @@ def calibrate(pairs: list[StereoFrame], board: tuple[int, int], square_mm: float
         views[i] = View(names[i], "used", float(e), corners[i])
     _rectify(mats, (w, h))
     epi = epipolar_rms(mats, [corners[i][0] for i in active], [corners[i][1] for i in active])
-    calib = Calibration((w, h), mats, rms, epi)
+    problem = edge_problem(mats, ([corners[i][0] for i in active],
+                                  [corners[i][1] for i in active]), (w, h))
+    calib = Calibration((w, h), mats, rms, epi, problem)
     return CalibrationRun(calib, [views[i] for i in range(len(pairs))])
+
+
+def edge_extrapolation_px(camera_matrix: np.ndarray, distortion: np.ndarray,
+                          corners: np.ndarray, size: tuple[int, int]) -> tuple[float, float, float]:
+    """How far the fitted lens model is extrapolated at the image's edge columns: (the gap in
+    px there between the model's radial displacement and that of its k1 term alone fitted to
+    the model where the boards' corners lie, the corners' largest radius, the edge columns'
+    radius; radii normalised by the focal length). Within the corners' reach the two higher
+    terms are pinned by the boards; beyond it only the k1 term's growth is measured, and what
+    more the model bends there comes from the fit's freedom, not from the lens."""
+    coefficients = np.asarray(distortion, np.float64).ravel()
+    k1 = float(coefficients[0]) if coefficients.size > 0 else 0.0
+    k2 = float(coefficients[1]) if coefficients.size > 1 else 0.0
+    k3 = float(coefficients[4]) if coefficients.size > 4 else 0.0
+    f, cx, cy = (float(camera_matrix[0, 0]), float(camera_matrix[0, 2]),
+                 float(camera_matrix[1, 2]))
+    pts = np.asarray(corners, np.float64).reshape(-1, 2)
+    r = np.hypot((pts[:, 0] - cx) / f, (pts[:, 1] - cy) / f)
+    w = size[0]
+    edge = max(cx, w - 1 - cx) / f
+
+    def moved(rr: np.ndarray | float) -> np.ndarray | float:
+        return k1 * rr ** 3 + k2 * rr ** 5 + k3 * rr ** 7
+
+    cubes = r ** 3
+    k1_alone = float(np.dot(np.asarray(moved(r)), cubes) / max(float(np.dot(cubes, cubes)),
+                                                               1e-12))
+    gap = f * abs(float(moved(edge)) - k1_alone * edge ** 3)
+    return gap, float(r.max()) if r.size else 0.0, edge
+
+
+def edge_problem(mats: dict[str, np.ndarray], corners: tuple[list[np.ndarray], list[np.ndarray]],
+                 size: tuple[int, int], limit_px: float = EDGE_EXTRAPOLATION_PX) -> str:
+    """"" when the boards pin the lens models down at the image's edge columns, else one line
+    naming the camera and the problem: its boards' corners stop short of the edge columns'
+    radius and the model bends beyond them by more than limit_px (edge_extrapolation_px).
+    corners: the used views' (left, right) corners."""
+    for side, (m, d, pts) in enumerate(((mats["M1"], mats["D1"], corners[0]),
+                                        (mats["M2"], mats["D2"], corners[1]))):
+        if not pts:
+            continue
+        gap, reach, edge = edge_extrapolation_px(m, d, np.concatenate(pts), size)
+        if reach < edge and gap > limit_px:
+            name = ("left", "right")[side]
+            return (f"the {name} lens model is not pinned down at the image's edge columns: "
+                    f"the boards reach radius {reach:.3f} of {edge:.3f}, and beyond them the "
+                    f"fit bends {gap:.2f} px from its k1 term (over {limit_px:.2f}); rectified "
+                    f"disparity there may be off by as much: show the board at the {name} "
+                    f"view's left and right edges")
+    return ""
 
 
 class Rectifier:

@@ -552,3 +552,109 @@ def in_view(u: float, v: float, ring_px: float, size: tuple[int, int], scale: fl
     cy = (h - 1) / 2 if cy is None else cy
     u2, v2, r2 = cx + (u - cx) * scale, cy + (v - cy) * scale, ring_px * scale + margin_px
     return r2 <= u2 <= w - 1 - r2 and r2 <= v2 <= h - 1 - r2
+
+
+# ------------------------------------------------- the calibration's leftover, by column
+
+
+BIAS_LIMIT_PX = 0.3  # a column bias this large somewhere is corrected (and said)
+BIAS_NOISE_PX = 0.25  # and only by what it has beyond this: the floor's leftover on cameras
+# whose calibration is right within 0.08 px reads 0.15-0.17 px (seed 16's camera 5), and
+# seed 105's cameras 0, 8, 13 read -0.4..+0.5 at the picture's two ends; seed 16's camera
+# 11 +0.61/+0.68 (trials 27, 299) at its left columns, for a true +0.7-1 px
+
+
+@dataclass(frozen=True)
+class ColumnBias:
+    """How much too high (px) the rectified pair reads disparity, by column of the right view,
+    measured on the floor (floor_column_bias). A calibration whose lens model is wrong where
+    its boards did not reach (the image's edges) rectifies one view a fraction of a pixel off
+    there: every disparity read at those columns is off by as much, whatever lies there."""
+
+    excess: np.ndarray  # (w,) px, by column of the right view (smoothed; held at the ends)
+    measured: int  # columns with floor enough to measure
+
+    def applied(self, noise_px: float = BIAS_NOISE_PX) -> np.ndarray:
+        """The excess trusted beyond the measure's noise: each column's shrunk toward 0 by
+        noise_px (px)."""
+        e = self.excess.astype(np.float32)
+        return np.sign(e) * np.maximum(np.abs(e) - np.float32(noise_px), np.float32(0))
+
+    @property
+    def largest(self) -> float:
+        """The largest excess (px, its sign kept)."""
+        k = int(np.argmax(np.abs(self.excess)))
+        return float(self.excess[k])
+
+    def describe(self) -> str:
+        """One line for the run's notes."""
+        k = int(np.argmax(np.abs(self.excess)))
+        return (f"the floor reads {self.excess[k]:+.2f} px of disparity off its fit at column "
+                f"{k} of the right view (the calibration's lens model is off there): "
+                f"disparities corrected by column")
+
+
+def floor_column_bias(disp: np.ndarray, floor: Floor | None, tol_px: float = 1.0,
+                      min_pixels: int = 6, smooth_px: int = 21,
+                      min_columns: int | None = None, edge_px: int = 6
+                      ) -> ColumnBias | None:
+    """The floor's leftover after its fit, by column of the right view (u - d): the median of
+    disp - floor(y) less its row's median over the floor's pixels (within tol_px of the line,
+    in the lowest 40 % of rows, a quarter of the row floor at least) that reach that column,
+    then a running mean over smooth_px columns; columns
+    without min_pixels of floor take the nearest measured one's. The fit is a line through
+    each row's most common disparity, so a bias common to all columns goes into its offset
+    and what is left is how the columns differ from the most of them: what a lens model
+    wrong at the image's edges does. None without a floor or with fewer than min_columns
+    (default a third of the width) measured."""
+    if floor is None:
+        return None
+    h, w = disp.shape
+    y0 = int(h * 0.6)
+    rows = np.arange(y0, h, dtype=np.float64)[:, None]
+    band = disp[y0:].astype(np.float64)
+    with np.errstate(invalid="ignore"):
+        resid = band - floor.disparity(rows)
+        on = np.isfinite(band) & (np.abs(resid) < tol_px)
+    # each row's leftover taken from its own (the line leaves a little in some rows, and the
+    # rows that reach a column differ from column to column)
+    counts_row = on.sum(axis=1)
+    level = np.zeros(len(band))
+    for i in np.flatnonzero(counts_row >= w // 4):
+        level[i] = float(np.median(resid[i][on[i]]))
+    on &= (counts_row >= w // 4)[:, None]
+    vs, us = np.nonzero(on)
+    right_col = np.rint(us - band[vs, us]).astype(np.int64)
+    # not where a view's border cuts the matcher's window (edge_px from either edge of either)
+    inside = (right_col >= edge_px) & (right_col < w - edge_px) & (us >= edge_px) & (
+        us < w - edge_px)
+    right_col, r = right_col[inside], (resid[vs, us] - level[vs])[inside]
+    order = np.argsort(right_col, kind="stable")
+    right_col, r = right_col[order], r[order]
+    cols, starts, counts = np.unique(right_col, return_index=True, return_counts=True)
+    med = np.full(w, np.nan)
+    for c, s, n in zip(cols, starts, counts):
+        if n >= min_pixels:
+            med[c] = float(np.median(r[s:s + n]))
+    known = np.flatnonzero(np.isfinite(med))
+    if known.size < (w // 3 if min_columns is None else min_columns):
+        return None
+    filled = np.interp(np.arange(w), known, med[known])  # held flat beyond the ends
+    k = max(1, smooth_px)
+    padded = np.pad(filled, (k // 2, k - 1 - k // 2), mode="edge")
+    smooth = np.convolve(padded, np.ones(k) / k, mode="valid")
+    return ColumnBias(smooth.astype(np.float32), int(known.size))
+
+
+def corrected_right(right: np.ndarray, bias: ColumnBias, noise_px: float = BIAS_NOISE_PX
+                    ) -> np.ndarray:
+    """The right view with each column's disparity excess beyond noise_px taken out
+    (ColumnBias.applied): the pixel at column x taken from x - excess[x] (a view read too far
+    left by e reads disparity e too high), so every disparity matched or measured on the pair
+    afterwards (maps, the marker, a face's alignment) is as the bias-free pair's, within
+    noise_px."""
+    h, w = right.shape[:2]
+    map_x = np.broadcast_to(np.arange(w, dtype=np.float32) - bias.applied(noise_px)[:w], (h, w))
+    map_y = np.broadcast_to(np.arange(h, dtype=np.float32)[:, None], (h, w))
+    return cv2.remap(right, np.ascontiguousarray(map_x), np.ascontiguousarray(map_y),
+                     cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
