@@ -83,3 +83,5 @@ def _report(result: CalibrationRun, n_pairs: int, used: list[View], written: lis
     for side, k in (("left", 0), ("right", 1)):
         counts = coverage([v.corners[k] for v in used if v.corners is not None], calib.size)
         print("\n".join(coverage_lines(counts, side)))
+    if result.problem:  # the lens model beyond the boards' reach (calibration.edge_problem)
+        print(f"  warning: {result.problem}")

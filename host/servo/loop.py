@@ -63,13 +63,17 @@ from host.servo.estimator import AGAINST, OUTSIDE, STILL, Estimator, EstimatorCo
 from host.servo.inputs import FrozenSensors, camera_moved, floor_shift_px, views_agree
 from host.servo.marker import RING_RATIO, MarkerPair, block_disparity, cut_views, marker_candidates
 from host.servo.perception import (
+    BIAS_LIMIT_PX,
+    ColumnBias,
     Floor,
     StripMap,
     Target,
     camera_height,
+    corrected_right,
     fit_floor,
     fixed_cells,
     fixed_in_path,
+    floor_column_bias,
     in_view,
     lane_obstacle,
     lane_window,
@@ -273,6 +277,9 @@ class Servo:
         self.tracker: TargetTracker | None = None
         self.controller: Controller | None = None
         self.floor: Floor | None = None
+        # the disparity the calibration adds by column, measured on the reference's floor
+        # (perception.floor_column_bias): every frame's right view is corrected by it
+        self.column_bias: ColumnBias | None = None
         self.camera_height_m = self.cfg.camera_height_m  # from the floor fit (reference)
         self.last_pair: MarkerPair | None = None  # the last admitted sighting
         self.rows: list[LogRow] = []
@@ -348,6 +355,14 @@ class Servo:
         return StereoFrame(frame.left, match_exposure(frame.left, frame.right), frame.t_left,
                            frame.t_right)
 
+    def _unbiased(self, frame: StereoFrame) -> StereoFrame:
+        """The pair with the reference's column bias taken out of its right view (as it
+        is when none was found)."""
+        if self.column_bias is None:
+            return frame
+        return StereoFrame(frame.left, corrected_right(frame.right, self.column_bias),
+                           frame.t_left, frame.t_right)
+
     # ------------------------------------------------------- the user's stop and the observers
 
     def request_stop(self, reason: str) -> None:
@@ -368,11 +383,12 @@ class Servo:
     # ------------------------------------------------------------------ reference phase
 
     def reference(self) -> Target:
-        disps = []
+        disps, frames = [], []
         for i in range(self.cfg.reference_frames):
             f = self._exposed(self._frame())
             if i == 0:
                 self._reference_image = reference_image(f.left)
+            frames.append(f)
             disps.append(compute_disparity(f.left, f.right, self.params))
             self._notify(f, Phase.REFERENCE, "measuring the scene", disps[-1], 0, None, None)
             self.link.stop()  # the robot stands while it waits
@@ -381,6 +397,15 @@ class Servo:
         self._strips = StripMap(self.params, (h, w))
         self._width = w
         target, self.floor = reference_target(disps, min_area)
+        bias = floor_column_bias(median_map(disps), self.floor)
+        if bias is not None and abs(bias.largest) >= BIAS_LIMIT_PX:
+            # the calibration is off at some columns: the reference again on corrected views
+            self.column_bias = bias
+            self.notes.append(bias.describe())
+            frames = [self._unbiased(g) for g in frames]
+            f = frames[-1]
+            disps = [compute_disparity(g.left, g.right, self.params) for g in frames]
+            target, self.floor = reference_target(disps, min_area)
         self._measure_height(self.floor)
         self.reference_map = median_map(disps)
         k = self._lane_scale = max(1, w // self.cfg.lane_width_px)
@@ -984,7 +1009,7 @@ class Servo:
         frame = self._frame()
         t_wall = time.perf_counter()
         frozen = self.frozen.update(frame)
-        frame = self._exposed(frame)
+        frame = self._unbiased(self._exposed(frame))
         t = frame.t_left
         # the command in force up to this frame (a stop's run-down spent before any check)
         self.estimator.commanded(t, self._cmd.left, self._cmd.right)
