@@ -240,7 +240,7 @@ class BackOff:
     def update(self, t: float, z: float | None, gap: float | None, target_m: float,
                confirmed: bool, facing_away: bool, trim: float,
                pushed_m: float = 0.0, floor: int = 0, steer: float = 0.0,
-               settled: bool = True) -> tuple[int, int]:
+               settled: bool = True, turned_m: float = 0.0) -> tuple[int, int]:
         """z: the robot's depth this frame at t (None: not seen, it stands; unseen unseen_s
         once it has moved, the back-off ends: the re-acquisition looks for the card, its
         spin checked as any); gap: the body's clearance across from the object's extent
@@ -257,7 +257,13 @@ class BackOff:
         wheel and given to the right (lane_steer: the new lane's pull), at most half the
         duty; none while the body is level with the object's face or behind it. settled:
         the body on the new lane and not moving across it (lane_m, lane_mps; the loop); not,
-        toward the camera, it backs off up to settle_m beyond block_m + clear_m."""
+        toward the camera, it backs off up to settle_m beyond block_m + clear_m. turned_m:
+        how much farther across than half its width the body reaches, turned as the card
+        shows it (the controller's reach_m less half_width_m): every rule judges the gap
+        less it, but for the pass by the end (corner_m: the half diagonal's reach, any turn,
+        beyond half the width: already the most a turn adds)."""
+        raw = gap
+        gap = None if gap is None else gap - max(0.0, turned_m)
         if z is not None:
             self.seen_t = t
         elif self.start_z is not None and self.seen_t is not None and \
@@ -292,7 +298,7 @@ class BackOff:
         level = abs(e) < cfg.level_m
         beside = e > -cfg.level_m
         tight = gap is not None and gap < cfg.side_m
-        near = gap is not None and gap < cfg.corner_m  # too near to pass the end turned
+        near = raw is not None and raw < cfg.corner_m  # too near to pass the end turned
         if beside and closing and (self.flipped or near):
             self.outcome = ("no safe way back: backing off either way closes on its side"
                             if self.flipped else
