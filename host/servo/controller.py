@@ -98,7 +98,12 @@ class ControlConfig:
     # at a slow speed is a steep heading, and a far card turned past ~40 degrees is lost
     trim_gain: float = 0.004  # learnt wheel trim, fraction of duty per cm of drift per second
     max_trim: float = 0.25
-    half_width_m: float = 0.08  # the robot's body, centre to side
+    half_width_m: float = 0.08  # the robot's body, centre to side (square to the camera axis)
+    # the body's reach across x turned (reach_m): the median of the last reach_frames
+    # sightings' turn bounds (the card's turn from its line of sight, acos of its aspect, and
+    # that line's bearing from the axis): the card's aspect is noisy near square (0.98 reads
+    # 11.5 degrees), one sighting alone is not taken
+    reach_frames: int = 10
     clearance_m: float = 0.15  # the lane's distance from the object's side: half the body,
     # and room for the lateral hold error and a sideways drift while holding
     block_m: float = 0.15  # within this depth of the object, the body must be clear of it
@@ -217,6 +222,8 @@ class Controller:
         self.fault = ""  # why the robot must stay stopped (the run ends), "" if none
         self._last_t: float | None = None
         self.history: list[Observation] = []  # valid observations since the last turn
+        # the recent sightings' bounds on the body's turn off the camera axis (rad; saw)
+        self.turns: list[float] = []
         self._turn: dict[str, Any] | None = None
         self._search_until: float | None = None
         self._seen_run = 0  # frames the card has been seen running
@@ -331,7 +338,7 @@ class Controller:
         reach = cfg.turn_radius_m + cfg.block_margin_m + slack_m
         near = any(abs(depth_m - z) < reach for z in (self.target_m, *self.readings_m))
         if (aged or near) and self.overlaps(
-                lateral_m, reach - cfg.half_width_m):
+                lateral_m, reach - cfg.turn_radius_m, cfg.turn_radius_m):
             return True
         return in_the_way(self.obstacles(depth_m, lateral_m), depth_m, lateral_m, None, 0.0,
                           reach + cfg.cell_m / 2) is not None
@@ -379,20 +386,58 @@ class Controller:
         if self.overlaps(lateral, cfg.block_margin_m):
             return True
         x0, x1 = self.keep_out
-        reach = cfg.half_width_m + cfg.block_margin_m
+        reach = self.reach_m() + cfg.block_margin_m
         gap = lateral - reach - x1 if lateral > x1 else x0 - reach - lateral
         toward = -rate if lateral > x1 else rate
         horizon = cfg.push_horizon_s if seen else cfg.unseen_horizon_s
         return toward > 0 and gap < toward * horizon
 
-    def overlaps(self, lateral: float | None, margin: float = 0.0) -> bool:
+    def overlaps(self, lateral: float | None, margin: float = 0.0,
+                 across: float | None = None) -> bool:
         """Whether the robot's body at this lateral position comes within margin of the
-        object's extent."""
+        object's extent: the body's reach across x (reach_m: turned as the card shows it),
+        or across, half an extent given (a turn's circle)."""
         if lateral is None or self.keep_out is None:
             return False
         x0, x1 = self.keep_out
-        reach = self.cfg.half_width_m + margin
+        reach = (self.reach_m() if across is None else across) + margin
         return x0 - reach < lateral < x1 + reach
+
+    def saw(self, depth_m: float | None, lateral_m: float | None, aspect: float) -> None:
+        """A sighting (the marker's depth and lateral, m; the card's aspect) bounds the
+        body's turn off the camera axis: the card's turn from its line of sight (aspect =
+        its |cos|) and that line's bearing from the axis, either way. Kept for the last
+        reach_frames sightings, through turns and back-offs (the loop tells a back-off's
+        sightings, whose commands are not the controller's)."""
+        if depth_m is None or depth_m <= 0:
+            return
+        bearing = abs(math.atan2(lateral_m or 0.0, depth_m))
+        self.turns.append(math.acos(min(1.0, max(0.0, aspect))) + bearing)
+        del self.turns[:-self.cfg.reach_frames]
+
+    def reach_m(self) -> float:
+        """Half the body's extent across x (m), the rectangle (half_width_m across,
+        half_length_m along) turned by the median of the recent sightings' turn bounds
+        (saw), never less than half its width (nothing seen: square). Every check of the
+        body beside the object takes it (overlaps, closing, the back-off's gap): turned 29
+        degrees past a turn round, seed 16 #470's body reached 10.8 cm across, not the 8 the
+        checks took, and its edge walked into the side of the box it held beside (issue 23)."""
+        cfg = self.cfg
+        if not self.turns:
+            return cfg.half_width_m
+        # the most a rectangle reaches across is at its diagonal's angle: beyond that a
+        # bound on the turn bounds the reach by the diagonal's
+        a = min(float(np.median(self.turns)), math.atan2(cfg.half_length_m, cfg.half_width_m))
+        return max(cfg.half_width_m,
+                   cfg.half_width_m * math.cos(a) + cfg.half_length_m * math.sin(a))
+
+    def gap_m(self, lateral: float) -> float | None:
+        """The body's clearance across from the object's extent (m, < 0: across it) at this
+        lateral position, with the body's reach (reach_m); None with no extent known."""
+        if self.keep_out is None:
+            return None
+        x0, x1 = self.keep_out
+        return max(lateral - x1, x0 - lateral) - self.reach_m()
 
     def update(self, obs: Observation) -> Command:
         self.turned_half = None
@@ -428,6 +473,7 @@ class Controller:
             self.lateral_ref = obs.lateral_m
         self.history.append(obs)
         del self.history[:-30]
+        self.saw(obs.depth_m, obs.lateral_m, obs.aspect)
         return self._drive(obs)
 
     def _drive(self, obs: Observation) -> Command:

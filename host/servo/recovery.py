@@ -170,6 +170,19 @@ class BackOffConfig:
     level_m: float = 0.12  # level with the face: the body's half diagonal (0.113) reaches it
     unseen_s: float = 1.0  # the card unseen this long backing off (turned away): re-acquired
     beyond_m: float = 0.02  # the robot this far beyond the object's face backs off deeper
+    # toward the camera, out of the object's depth but not yet settled on the new lane (the
+    # loop: off it by more than lane_m, or moving across faster than lane_mps, a heading of
+    # ~6 degrees at the back-off's ~9 cm/s), it backs off up to settle_m more: a back-off
+    # steered onto its lane ends turned 14-19 degrees the way that, driving in again, swings
+    # the body 2-3 cm back toward the object's side, and the turned body's reach (the
+    # controller's reach_m) took it within the check's margin before the lane was won
+    # (tests/servo/test_back_off.py's closed loop, four times). Never nearer the camera than
+    # camera_m + camera_room_m (that ends it done, not named; max_m bounds only the depth
+    # travelled before it is out of the object's depth)
+    settle_m: float = 0.15
+    camera_room_m: float = 0.05
+    lane_m: float = 0.01
+    lane_mps: float = 0.01
     corner_m: float = 0.033  # the body's half diagonal less its half width (0.113 - 0.08):
     # how far a corner of a body turned any way reaches beyond the side the gap is reckoned
     # for. Level with the face, closing, the other way runs the body past the object's end:
@@ -210,6 +223,14 @@ class BackOff:
         self.flipped = False
         self.seen_t: float | None = None  # the card last seen
 
+    def _settle_spent(self, z: float, e: float) -> bool:
+        """Backing off toward the camera past block_m + clear_m to settle on the lane: the
+        most it goes (settle_m more), or as near the camera as leaves camera_room_m before
+        the limit that ends it named (camera_m)."""
+        cfg = self.cfg
+        return (abs(e) >= self.block_m + cfg.clear_m + cfg.settle_m
+                or z < cfg.camera_m + cfg.camera_room_m)
+
     @property
     def way(self) -> int | None:
         """The way it backs off in depth: +1 away from the camera, -1 toward it, None
@@ -218,7 +239,8 @@ class BackOff:
 
     def update(self, t: float, z: float | None, gap: float | None, target_m: float,
                confirmed: bool, facing_away: bool, trim: float,
-               pushed_m: float = 0.0, floor: int = 0, steer: float = 0.0) -> tuple[int, int]:
+               pushed_m: float = 0.0, floor: int = 0, steer: float = 0.0,
+               settled: bool = True, turned_m: float = 0.0) -> tuple[int, int]:
         """z: the robot's depth this frame at t (None: not seen, it stands; unseen unseen_s
         once it has moved, the back-off ends: the re-acquisition looks for the card, its
         spin checked as any); gap: the body's clearance across from the object's extent
@@ -233,7 +255,15 @@ class BackOff:
         controller's, raised by stiction or a sagging battery): no wheel is driven below it,
         so the back-off moves where the drive would. steer: permille taken from the left
         wheel and given to the right (lane_steer: the new lane's pull), at most half the
-        duty; none while the body is level with the object's face or behind it."""
+        duty; none while the body is level with the object's face or behind it. settled:
+        the body on the new lane and not moving across it (lane_m, lane_mps; the loop); not,
+        toward the camera, it backs off up to settle_m beyond block_m + clear_m. turned_m:
+        how much farther across than half its width the body reaches, turned as the card
+        shows it (the controller's reach_m less half_width_m): every rule judges the gap
+        less it, but for the pass by the end (corner_m: the half diagonal's reach, any turn,
+        beyond half the width: already the most a turn adds)."""
+        raw = gap
+        gap = None if gap is None else gap - max(0.0, turned_m)
         if z is not None:
             self.seen_t = t
         elif self.start_z is not None and self.seen_t is not None and \
@@ -250,7 +280,8 @@ class BackOff:
         first = self.start_z is None
         if first:
             self.deeper, self.start_z, self.start_gap = e > cfg.beyond_m, z, gap
-        if abs(e) >= self.block_m + (0.0 if first else cfg.clear_m):
+        out = self.block_m + (0.0 if first else cfg.clear_m)
+        if abs(e) >= out and (first or self.deeper or settled or self._settle_spent(z, e)):
             self.outcome = DONE  # out of the object's depth (measured again: never in it)
             return 0, 0
         assert self.start_z is not None
@@ -267,7 +298,7 @@ class BackOff:
         level = abs(e) < cfg.level_m
         beside = e > -cfg.level_m
         tight = gap is not None and gap < cfg.side_m
-        near = gap is not None and gap < cfg.corner_m  # too near to pass the end turned
+        near = raw is not None and raw < cfg.corner_m  # too near to pass the end turned
         if beside and closing and (self.flipped or near):
             self.outcome = ("no safe way back: backing off either way closes on its side"
                             if self.flipped else
@@ -282,7 +313,7 @@ class BackOff:
                             "across its extent")
         elif level and gap is not None and gap < 0 <= (self.start_gap or 0.0):
             self.outcome = "no safe way back: the body is at the object's side"
-        elif abs(z - self.start_z) > cfg.max_m:
+        elif abs(z - self.start_z) > cfg.max_m and abs(e) < out:  # not yet out of its depth
             self.outcome = f"no safe way back: {cfg.max_m:.2f} m backed off and still beside it"
         elif not self.deeper and z < cfg.camera_m:
             self.outcome = "no safe way back: the camera is behind the robot"
@@ -301,6 +332,15 @@ class BackOff:
         bend = 0.0 if beside else max(-abs(d) / 2, min(abs(d) / 2, steer))
         left, right = lifted(d * (1 - trim) - bend, d * (1 + trim) + bend, floor, d)
         return int(round(left)), int(round(right))
+
+
+def settled_on(lateral_m: float | None, lane_m: float | None, vx_mps: float,
+               cfg: BackOffConfig = BackOffConfig()) -> bool:
+    """Whether the body is on its new lane (within lane_m) and not moving across it (slower
+    than lane_mps): BackOff.update's settled; True where either is not known."""
+    if lateral_m is None or lane_m is None:
+        return True
+    return abs(lateral_m - lane_m) <= cfg.lane_m and abs(vx_mps) <= cfg.lane_mps
 
 
 def lane_steer(way: int, lateral_m: float, lane_m: float, vx_mps: float, gain: float,

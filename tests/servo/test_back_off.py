@@ -12,6 +12,7 @@ import math
 
 import pytest
 
+from host.servo.controller import ControlConfig
 from host.servo.recovery import DONE, BackOff, BackOffConfig
 from host.sim.faults import MotorFaults, WorldFaults
 from host.sim.run import Setup, simulation
@@ -115,7 +116,10 @@ def test_in_closed_loop_a_robot_pushed_while_it_holds_backs_off_and_holds_again(
     6 cm from the object's side) while a slope pushes it toward the object at 8 mm/s. It
     backed off and planned its lane anew rather than ending the run ("pushed sideways onto
     the object while holding", as it did before the back-off), and holds again, its body
-    never touching the object (the trials' judge)."""
+    never touching the object (the trials' judge), and its body as it truly is, turned
+    (13-20 degrees: the lane's steer against the push), clear of the object's side by the
+    checks' margin when it holds (controller.reach_m: the half width alone was taken, it
+    held 1.5 cm from the side, turned 19.6 degrees, the push closing at 8 mm/s)."""
     faults = WorldFaults(motor=MotorFaults(push_mps=-0.008))
     with simulation(Setup(start_z_m=1.25, start_x_m=-0.04, faults=faults, seed=3)) as sim:
         servo, judged, outcome = sim.servo, Judged(sim), "unsettled"
@@ -130,3 +134,6 @@ def test_in_closed_loop_a_robot_pushed_while_it_holds_backs_off_and_holds_again(
                 break
         assert outcome == "held"
         assert any("backed off" in note for note in servo.notes)
+        r, box = sim.world.robot, sim.world.nearest_box()
+        side = max(box.x0_m - r.x_m, r.x_m - box.x1_m) - r.half_extent()[0]
+        assert side >= ControlConfig().block_margin_m, side
