@@ -103,6 +103,7 @@ from host.servo.recovery import (
     Recovery,
     lane_steer,
     servo_bounds,
+    settled_on,
 )
 from host.servo.recovery import OUTSIDE as OUTSIDE_KIND
 from host.servo.refind import FOUND, WHOLE, LostCard, Refind, RefindConfig
@@ -1077,9 +1078,11 @@ class Servo:
         if self._must_stop():  # the motion check may have ended the run
             return Command(0, 0, Phase.STOP, None)
         depth, lateral = position if position is not None else (None, None)
-        if self.backoff is not None:
-            return self._backing_off(t, depth, lateral)
         aspect = pair.left.aspect if pair is not None else 1.0
+        if self.backoff is not None:
+            # its sightings bound the body's turn for the back-off's gap (controller.reach_m)
+            self.controller.saw(depth, lateral, aspect)
+            return self._backing_off(t, depth, lateral)
         cmd = self.controller.update(Observation(t, depth, lateral, aspect, invalid))
         if self.controller.fault:  # it cannot go on as it was: back off, or the run ends
             if depth is not None and self._back_off(t, self.controller.fault):
@@ -1126,8 +1129,10 @@ class Servo:
         if lateral is not None and lane is not None and st is not None and b.way is not None:
             steer = lane_steer(b.way, lateral, lane, st.vx, c.cfg.steer_gain,
                                c.cfg.steer_damping)
+        settled = settled_on(lateral, lane, 0.0 if st is None else st.vx, b.cfg)
         left, right = b.update(t, depth, gap, c.target_m, self.tracker_confirmed, c.facing_away,
-                               c.trim, pushed, c.floor, steer)
+                               c.trim, pushed, c.floor, steer, settled,
+                               c.reach_m() - c.cfg.half_width_m)  # turned as the card shows
         if b.outcome == DONE:
             rec.update(t, True)
             self.backoff = None
