@@ -118,6 +118,44 @@ def _coverage_of(qx: np.ndarray, qy: np.ndarray, ts: np.ndarray) -> np.ndarray:
     return out
 
 
+@njit(cache=True)
+def _draw_marker(patch: np.ndarray, disp: np.ndarray, qx: np.ndarray, qy: np.ndarray,
+                 t_ring: float, t_disc: float, nearer: np.float32, d: float) -> None:
+    """Renderer._marker's drawing in one pass: each pixel's ring and disc coverage as
+    _coverage_of makes them, and where the scene is not nearer than `nearer` (float32, as
+    numpy compares the float32 disparity with a Python float) the patch's grey level made as
+    numpy makes it (float64: patch * (1 - ring) + light * (ring - disc) + dark * disc, then
+    float32) and the disparity d where the ring covers over half the pixel."""
+    rows, cols = qy.shape[0], qx.shape[0]
+    ts = (t_ring, t_disc)
+    cov = np.empty(2)
+    for i in range(rows):
+        y_lo, y_hi = qy[i].min(), qy[i].max()
+        for j in range(cols):
+            hi = y_hi + qx[j].max()
+            lo = y_lo + qx[j].min()
+            for k in range(2):
+                t = ts[k]
+                if hi <= t:
+                    cov[k] = 1.0
+                elif lo > t:
+                    cov[k] = 0.0
+                else:
+                    n = 0
+                    for a in range(qy.shape[1]):
+                        for b in range(qx.shape[1]):
+                            n += qx[j, b] + qy[i, a] <= t
+                    cov[k] = n / 16
+            if disp[i, j] > nearer:
+                continue
+            ring, disc = cov[0], cov[1]
+            drawn = (np.float64(patch[i, j]) * (1 - ring) + MARKER_LIGHT * (ring - disc)
+                     + MARKER_DARK * disc)
+            patch[i, j] = drawn
+            if ring > 0.5:
+                disp[i, j] = d
+
+
 LensBounds = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
 
@@ -377,13 +415,13 @@ class Renderer:
         sub = (np.arange(4) + 0.5) / 4 - 0.5
         qy = ((np.arange(r0, r1)[:, None] + sub - v) / ry) ** 2  # rows x 4 sub-rows
         qx = ((np.arange(c0, c1)[:, None] + sub - u) / rx) ** 2  # columns x 4 sub-columns
-        ring_cov, disc_cov = _coverage(qx, qy, (ring * ring, 1.0))
-        patch = image[r0:r1, c0:c1]
-        shown = ~(disp[r0:r1, c0:c1] > d + NEARER_PX)
-        light = ring_cov - disc_cov
-        drawn = patch * (1 - ring_cov) + MARKER_LIGHT * light + MARKER_DARK * disc_cov
-        patch[shown] = drawn[shown]
-        disp[r0:r1, c0:c1][(ring_cov > 0.5) & shown] = d
+        # in one compiled pass, the same arithmetic as (tests/sim/test_marker_coverage.py):
+        #   ring_cov, disc_cov = _coverage(qx, qy, (ring * ring, 1.0))
+        #   shown = ~(disp[r0:r1, c0:c1] > d + NEARER_PX)
+        #   drawn = patch * (1 - ring_cov) + MARKER_LIGHT * light + MARKER_DARK * disc_cov
+        #   patch[shown] = drawn[shown]; disp[r0:r1, c0:c1][(ring_cov > 0.5) & shown] = d
+        _draw_marker(image[r0:r1, c0:c1], disp[r0:r1, c0:c1], qx, qy, ring * ring, 1.0,
+                     np.float32(d + NEARER_PX), float(d))
 
     # ------------------------------------------------------------------------------ views
 
