@@ -120,12 +120,12 @@ def _coverage_of(qx: np.ndarray, qy: np.ndarray, ts: np.ndarray) -> np.ndarray:
 
 @njit(cache=True)
 def _draw_marker(patch: np.ndarray, disp: np.ndarray, qx: np.ndarray, qy: np.ndarray,
-                 t_ring: float, t_disc: float, nearer: np.float32, d: float) -> None:
+                 t_ring: float, t_disc: float, nearer: float, d: float) -> None:
     """Renderer._marker's drawing in one pass: each pixel's ring and disc coverage as
-    _coverage_of makes them, and where the scene is not nearer than `nearer` (float32, as
-    numpy compares the float32 disparity with a Python float) the patch's grey level made as
-    numpy makes it (float64: patch * (1 - ring) + light * (ring - disc) + dark * disc, then
-    float32) and the disparity d where the ring covers over half the pixel."""
+    _coverage_of makes them, and where the scene is not nearer than `nearer` (_limit) the
+    patch's grey level made as numpy makes it (float64: patch * (1 - ring) + light * (ring -
+    disc) + dark * disc, then float32) and the disparity d where the ring covers over half the
+    pixel."""
     rows, cols = qy.shape[0], qx.shape[0]
     ts = (t_ring, t_disc)
     cov = np.empty(2)
@@ -146,7 +146,7 @@ def _draw_marker(patch: np.ndarray, disp: np.ndarray, qx: np.ndarray, qy: np.nda
                         for b in range(qx.shape[1]):
                             n += qx[j, b] + qy[i, a] <= t
                     cov[k] = n / 16
-            if disp[i, j] > nearer:
+            if np.float64(disp[i, j]) > nearer:
                 continue
             ring, disc = cov[0], cov[1]
             drawn = (np.float64(patch[i, j]) * (1 - ring) + MARKER_LIGHT * (ring - disc)
@@ -154,6 +154,31 @@ def _draw_marker(patch: np.ndarray, disp: np.ndarray, qx: np.ndarray, qy: np.nda
             patch[i, j] = drawn
             if ring > 0.5:
                 disp[i, j] = d
+
+
+@njit(cache=True)
+def _draw_surface(image: np.ndarray, disp: np.ndarray, texture: np.ndarray, grey: float,
+                  nearer: float, d: float) -> None:
+    """Renderer._paint's drawing in one pass: where the scene is not nearer than `nearer`
+    (_limit), the texture from its corner, repeated where the box is larger (or the uniform
+    grey where the texture is empty), and the disparity d."""
+    th, tw = texture.shape
+    for i in range(image.shape[0]):
+        for j in range(image.shape[1]):
+            if np.float64(disp[i, j]) > nearer:
+                continue
+            image[i, j] = texture[i % th, j % tw] if th else grey
+            disp[i, j] = d
+
+
+_NO_TEXTURE = np.zeros((0, 1), np.float32)
+
+
+def _limit(d: float) -> float:
+    """d + NEARER_PX as numpy compared a float32 disparity map with it (`disp > d +
+    NEARER_PX`): a Python float is taken to float32 first, a numpy float64 is not."""
+    limit = d + NEARER_PX
+    return float(np.float32(limit)) if type(limit) is float else float(limit)
 
 
 LensBounds = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
@@ -390,16 +415,12 @@ class Renderer:
         if c0 >= c1 or r0 >= r1:
             return
         self._touch(image, disp, r0, r1, c0, c1)
-        shown = ~(disp[r0:r1, c0:c1] > d + NEARER_PX)
-        if texture is not None:  # the texture from its corner, repeated where the box is larger
-            th, tw = texture.shape
-            surface = texture[:r1 - r0, :c1 - c0]
-            if r1 - r0 > th or c1 - c0 > tw:
-                surface = texture[np.arange(r1 - r0) % th][:, np.arange(c1 - c0) % tw]
-            np.copyto(image[r0:r1, c0:c1], surface, where=shown)
-        else:
-            image[r0:r1, c0:c1][shown] = 60.0
-        disp[r0:r1, c0:c1][shown] = d
+        # in one compiled pass, the same as:
+        #   shown = ~(disp[r0:r1, c0:c1] > d + NEARER_PX)
+        #   np.copyto(image[r0:r1, c0:c1], texture from its corner (tiled), where=shown), or
+        #   image[r0:r1, c0:c1][shown] = 60.0 without one; disp[r0:r1, c0:c1][shown] = d
+        _draw_surface(image[r0:r1, c0:c1], disp[r0:r1, c0:c1],
+                      _NO_TEXTURE if texture is None else texture, 60.0, _limit(d), float(d))
 
     def _marker(self, image: np.ndarray, disp: np.ndarray, u: float, v: float, rx: float,
                 ry: float, d: float, ring: float) -> None:
@@ -421,7 +442,7 @@ class Renderer:
         #   drawn = patch * (1 - ring_cov) + MARKER_LIGHT * light + MARKER_DARK * disc_cov
         #   patch[shown] = drawn[shown]; disp[r0:r1, c0:c1][(ring_cov > 0.5) & shown] = d
         _draw_marker(image[r0:r1, c0:c1], disp[r0:r1, c0:c1], qx, qy, ring * ring, 1.0,
-                     np.float32(d + NEARER_PX), float(d))
+                     _limit(d), float(d))
 
     # ------------------------------------------------------------------------------ views
 
