@@ -119,14 +119,26 @@ def _coverage_of(qx: np.ndarray, qy: np.ndarray, ts: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True)
-def _draw_marker(patch: np.ndarray, disp: np.ndarray, qx: np.ndarray, qy: np.ndarray,
-                 t_ring: float, t_disc: float, nearer: float, d: float) -> None:
-    """Renderer._marker's drawing in one pass: each pixel's ring and disc coverage as
-    _coverage_of makes them, and where the scene is not nearer than `nearer` (_limit) the
-    patch's grey level made as numpy makes it (float64: patch * (1 - ring) + light * (ring -
-    disc) + dark * disc, then float32) and the disparity d where the ring covers over half the
-    pixel."""
-    rows, cols = qy.shape[0], qx.shape[0]
+def _draw_marker(patch: np.ndarray, disp: np.ndarray, r0: int, c0: int, u: float, v: float,
+                 rx: float, ry: float, t_ring: float, t_disc: float, d: float,
+                 weak: bool) -> None:
+    """Renderer._marker's drawing in one pass over the patch (its rows from r0, columns from
+    c0): each pixel's 4x4 samples' terms (((row + sub - v) / ry)^2 as numpy made them, the
+    same for columns), its ring and disc coverage as _coverage_of makes them, and where the
+    scene is not nearer (_nearer) the patch's grey level made as numpy makes it (float64:
+    patch * (1 - ring) + light * (ring - disc) + dark * disc, then float32) and the disparity
+    d where the ring covers over half the pixel."""
+    rows, cols = patch.shape
+    nearer = _nearer(d, weak)
+    qy, qx = np.empty((rows, 4)), np.empty((cols, 4))
+    for a in range(4):
+        sub = (a + 0.5) / 4 - 0.5
+        for i in range(rows):
+            y = (np.float64(r0 + i) + sub - v) / ry
+            qy[i, a] = y * y
+        for j in range(cols):
+            x = (np.float64(c0 + j) + sub - u) / rx
+            qx[j, a] = x * x
     ts = (t_ring, t_disc)
     cov = np.empty(2)
     for i in range(rows):
@@ -158,10 +170,11 @@ def _draw_marker(patch: np.ndarray, disp: np.ndarray, qx: np.ndarray, qy: np.nda
 
 @njit(cache=True)
 def _draw_surface(image: np.ndarray, disp: np.ndarray, texture: np.ndarray, grey: float,
-                  nearer: float, d: float) -> None:
-    """Renderer._paint's drawing in one pass: where the scene is not nearer than `nearer`
-    (_limit), the texture from its corner, repeated where the box is larger (or the uniform
-    grey where the texture is empty), and the disparity d."""
+                  d: float, weak: bool) -> None:
+    """Renderer._paint's drawing in one pass: where the scene is not nearer (_nearer), the
+    texture from its corner, repeated where the box is larger (or the uniform grey where the
+    texture is empty), and the disparity d."""
+    nearer = _nearer(d, weak)
     th, tw = texture.shape
     for i in range(image.shape[0]):
         for j in range(image.shape[1]):
@@ -174,11 +187,13 @@ def _draw_surface(image: np.ndarray, disp: np.ndarray, texture: np.ndarray, grey
 _NO_TEXTURE = np.zeros((0, 1), np.float32)
 
 
-def _limit(d: float) -> float:
+@njit(cache=True)
+def _nearer(d: float, weak: bool) -> float:
     """d + NEARER_PX as numpy compared a float32 disparity map with it (`disp > d +
-    NEARER_PX`): a Python float is taken to float32 first, a numpy float64 is not."""
+    NEARER_PX`): rounded to float32 first when d is a Python float (weak: numpy takes it to the
+    array's type), not when it is a numpy float64."""
     limit = d + NEARER_PX
-    return float(np.float32(limit)) if type(limit) is float else float(limit)
+    return np.float64(np.float32(limit)) if weak else limit
 
 
 LensBounds = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
@@ -420,7 +435,8 @@ class Renderer:
         #   np.copyto(image[r0:r1, c0:c1], texture from its corner (tiled), where=shown), or
         #   image[r0:r1, c0:c1][shown] = 60.0 without one; disp[r0:r1, c0:c1][shown] = d
         _draw_surface(image[r0:r1, c0:c1], disp[r0:r1, c0:c1],
-                      _NO_TEXTURE if texture is None else texture, 60.0, _limit(d), float(d))
+                      _NO_TEXTURE if texture is None else texture, 60.0, d,
+                      type(d + NEARER_PX) is float)
 
     def _marker(self, image: np.ndarray, disp: np.ndarray, u: float, v: float, rx: float,
                 ry: float, d: float, ring: float) -> None:
@@ -433,16 +449,16 @@ class Renderer:
         if c0 >= c1 or r0 >= r1:
             return
         self._touch(image, disp, r0, r1, c0, c1)
-        sub = (np.arange(4) + 0.5) / 4 - 0.5
-        qy = ((np.arange(r0, r1)[:, None] + sub - v) / ry) ** 2  # rows x 4 sub-rows
-        qx = ((np.arange(c0, c1)[:, None] + sub - u) / rx) ** 2  # columns x 4 sub-columns
-        # in one compiled pass, the same arithmetic as (tests/sim/test_marker_coverage.py):
+        # in one compiled pass, the same arithmetic as (tests/sim/test_render_kernels.py):
+        #   sub = (np.arange(4) + 0.5) / 4 - 0.5
+        #   qy = ((np.arange(r0, r1)[:, None] + sub - v) / ry) ** 2  # rows x 4 sub-rows
+        #   qx = ((np.arange(c0, c1)[:, None] + sub - u) / rx) ** 2  # columns x 4 sub-columns
         #   ring_cov, disc_cov = _coverage(qx, qy, (ring * ring, 1.0))
         #   shown = ~(disp[r0:r1, c0:c1] > d + NEARER_PX)
         #   drawn = patch * (1 - ring_cov) + MARKER_LIGHT * light + MARKER_DARK * disc_cov
         #   patch[shown] = drawn[shown]; disp[r0:r1, c0:c1][(ring_cov > 0.5) & shown] = d
-        _draw_marker(image[r0:r1, c0:c1], disp[r0:r1, c0:c1], qx, qy, ring * ring, 1.0,
-                     _limit(d), float(d))
+        _draw_marker(image[r0:r1, c0:c1], disp[r0:r1, c0:c1], r0, c0, u, v, rx, ry,
+                     ring * ring, 1.0, d, type(d + NEARER_PX) is float)
 
     # ------------------------------------------------------------------------------ views
 
