@@ -119,16 +119,17 @@ def _coverage_of(qx: np.ndarray, qy: np.ndarray, ts: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True)
-def _draw_marker(patch: np.ndarray, disp: np.ndarray, r0: int, c0: int, u: float, v: float,
-                 rx: float, ry: float, t_ring: float, t_disc: float, d: float,
-                 weak: bool) -> None:
-    """Renderer._marker's drawing in one pass over the patch (its rows from r0, columns from
-    c0): each pixel's 4x4 samples' terms (((row + sub - v) / ry)^2 as numpy made them, the
-    same for columns), its ring and disc coverage as _coverage_of makes them, and where the
-    scene is not nearer (_nearer) the patch's grey level made as numpy makes it (float64:
-    patch * (1 - ring) + light * (ring - disc) + dark * disc, then float32) and the disparity
+def _draw_marker(image: np.ndarray, disp: np.ndarray, r0: int, r1: int, c0: int, c1: int,
+                 u: float, v: float, rx: float, ry: float, t_ring: float, t_disc: float,
+                 d: float, weak: bool) -> None:
+    """Renderer._marker's drawing in one pass over rows r0:r1, columns c0:c1 of the whole
+    image and disparity (whole arrays: one compiled signature, where a slice's layout varies
+    with its shape): each pixel's 4x4 samples' terms (((row + sub - v) / ry)^2 as numpy made
+    them, the same for columns), its ring and disc coverage as _coverage_of makes them, and
+    where the scene is not nearer (_nearer) its grey level made as numpy makes it (float64:
+    level * (1 - ring) + light * (ring - disc) + dark * disc, then float32) and the disparity
     d where the ring covers over half the pixel."""
-    rows, cols = patch.shape
+    rows, cols = r1 - r0, c1 - c0
     nearer = _nearer(d, weak)
     qy, qx = np.empty((rows, 4)), np.empty((cols, 4))
     for a in range(4):
@@ -158,30 +159,31 @@ def _draw_marker(patch: np.ndarray, disp: np.ndarray, r0: int, c0: int, u: float
                         for b in range(qx.shape[1]):
                             n += qx[j, b] + qy[i, a] <= t
                     cov[k] = n / 16
-            if np.float64(disp[i, j]) > nearer:
+            if np.float64(disp[r0 + i, c0 + j]) > nearer:
                 continue
             ring, disc = cov[0], cov[1]
-            drawn = (np.float64(patch[i, j]) * (1 - ring) + MARKER_LIGHT * (ring - disc)
-                     + MARKER_DARK * disc)
-            patch[i, j] = drawn
+            drawn = (np.float64(image[r0 + i, c0 + j]) * (1 - ring)
+                     + MARKER_LIGHT * (ring - disc) + MARKER_DARK * disc)
+            image[r0 + i, c0 + j] = drawn
             if ring > 0.5:
-                disp[i, j] = d
+                disp[r0 + i, c0 + j] = d
 
 
 @njit(cache=True)
-def _draw_surface(image: np.ndarray, disp: np.ndarray, texture: np.ndarray, grey: float,
-                  d: float, weak: bool) -> None:
-    """Renderer._paint's drawing in one pass: where the scene is not nearer (_nearer), the
-    texture from its corner, repeated where the box is larger (or the uniform grey where the
-    texture is empty), and the disparity d."""
+def _draw_surface(image: np.ndarray, disp: np.ndarray, r0: int, r1: int, c0: int, c1: int,
+                  texture: np.ndarray, grey: float, d: float, weak: bool) -> None:
+    """Renderer._paint's drawing in one pass over rows r0:r1, columns c0:c1 of the whole image
+    and disparity: where the scene is not nearer (_nearer), the texture from its corner,
+    repeated where the box is larger (or the uniform grey where the texture is empty), and the
+    disparity d."""
     nearer = _nearer(d, weak)
     th, tw = texture.shape
-    for i in range(image.shape[0]):
-        for j in range(image.shape[1]):
-            if np.float64(disp[i, j]) > nearer:
+    for i in range(r1 - r0):
+        for j in range(c1 - c0):
+            if np.float64(disp[r0 + i, c0 + j]) > nearer:
                 continue
-            image[i, j] = texture[i % th, j % tw] if th else grey
-            disp[i, j] = d
+            image[r0 + i, c0 + j] = texture[i % th, j % tw] if th else grey
+            disp[r0 + i, c0 + j] = d
 
 
 _NO_TEXTURE = np.zeros((0, 1), np.float32)
@@ -434,9 +436,8 @@ class Renderer:
         #   shown = ~(disp[r0:r1, c0:c1] > d + NEARER_PX)
         #   np.copyto(image[r0:r1, c0:c1], texture from its corner (tiled), where=shown), or
         #   image[r0:r1, c0:c1][shown] = 60.0 without one; disp[r0:r1, c0:c1][shown] = d
-        _draw_surface(image[r0:r1, c0:c1], disp[r0:r1, c0:c1],
-                      _NO_TEXTURE if texture is None else texture, 60.0, d,
-                      type(d + NEARER_PX) is float)
+        _draw_surface(image, disp, r0, r1, c0, c1, _NO_TEXTURE if texture is None else texture,
+                      60.0, d, type(d + NEARER_PX) is float)
 
     def _marker(self, image: np.ndarray, disp: np.ndarray, u: float, v: float, rx: float,
                 ry: float, d: float, ring: float) -> None:
@@ -457,8 +458,8 @@ class Renderer:
         #   shown = ~(disp[r0:r1, c0:c1] > d + NEARER_PX)
         #   drawn = patch * (1 - ring_cov) + MARKER_LIGHT * light + MARKER_DARK * disc_cov
         #   patch[shown] = drawn[shown]; disp[r0:r1, c0:c1][(ring_cov > 0.5) & shown] = d
-        _draw_marker(image[r0:r1, c0:c1], disp[r0:r1, c0:c1], r0, c0, u, v, rx, ry,
-                     ring * ring, 1.0, d, type(d + NEARER_PX) is float)
+        _draw_marker(image, disp, r0, r1, c0, c1, u, v, rx, ry, ring * ring, 1.0, d,
+                     type(d + NEARER_PX) is float)
 
     # ------------------------------------------------------------------------------ views
 
