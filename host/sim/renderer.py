@@ -179,11 +179,14 @@ def _draw_surface(image: np.ndarray, disp: np.ndarray, r0: int, r1: int, c0: int
     nearer = _nearer(d, weak)
     th, tw = texture.shape
     for i in range(r1 - r0):
+        ti, tj = (i % th if th else 0), 0  # the texture's row and column (no % a pixel)
         for j in range(c1 - c0):
-            if np.float64(disp[r0 + i, c0 + j]) > nearer:
-                continue
-            image[r0 + i, c0 + j] = texture[i % th, j % tw] if th else grey
-            disp[r0 + i, c0 + j] = d
+            if not np.float64(disp[r0 + i, c0 + j]) > nearer:  # NaN: no scene there
+                image[r0 + i, c0 + j] = texture[ti, tj] if th else grey
+                disp[r0 + i, c0 + j] = d
+            tj += 1
+            if tj == tw:
+                tj = 0
 
 
 _NO_TEXTURE = np.zeros((0, 1), np.float32)
