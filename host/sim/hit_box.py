@@ -28,11 +28,25 @@ def hit_of(row_lo: np.ndarray, row_hi: np.ndarray, col_lo: np.ndarray, col_hi: n
     y0, y1, x0, x1 = -1, -1, col_lo.size, -1
     if ra < 0 or ca < 0:
         return y0, y1, x0, x1
+    # each row's first pixel inside from the left and its last from the right: the pixels
+    # between need no look (the box takes only its rows' extremes), so a row costs its
+    # pixels outside the box, not all of them
     for y in range(ra, rb):
+        first = -1
         for x in range(ca, cb):
             sx, sy = mx[y, x], my[y, x]
             if sx > lo_x and sx < hi_x and sy > lo_y and sy < hi_y:
-                y0 = y if y0 < 0 else y0
-                y1 = y + 1
-                x0, x1 = min(x0, x), max(x1, x + 1)
+                first = x
+                break
+        if first < 0:
+            continue
+        last = first
+        for x in range(cb - 1, first, -1):
+            sx, sy = mx[y, x], my[y, x]
+            if sx > lo_x and sx < hi_x and sy > lo_y and sy < hi_y:
+                last = x
+                break
+        y0 = y if y0 < 0 else y0
+        y1 = y + 1
+        x0, x1 = min(x0, first), max(x1, last + 1)
     return y0, y1, x0, x1

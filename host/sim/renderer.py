@@ -118,6 +118,89 @@ def _coverage_of(qx: np.ndarray, qy: np.ndarray, ts: np.ndarray) -> np.ndarray:
     return out
 
 
+@njit(cache=True)
+def _draw_marker(image: np.ndarray, disp: np.ndarray, r0: int, r1: int, c0: int, c1: int,
+                 u: float, v: float, rx: float, ry: float, t_ring: float, t_disc: float,
+                 d: float, weak: bool) -> None:
+    """Renderer._marker's drawing in one pass over rows r0:r1, columns c0:c1 of the whole
+    image and disparity (whole arrays: one compiled signature, where a slice's layout varies
+    with its shape): each pixel's 4x4 samples' terms (((row + sub - v) / ry)^2 as numpy made
+    them, the same for columns), its ring and disc coverage as _coverage_of makes them, and
+    where the scene is not nearer (_nearer) its grey level made as numpy makes it (float64:
+    level * (1 - ring) + light * (ring - disc) + dark * disc, then float32) and the disparity
+    d where the ring covers over half the pixel."""
+    rows, cols = r1 - r0, c1 - c0
+    nearer = _nearer(d, weak)
+    qy, qx = np.empty((rows, 4)), np.empty((cols, 4))
+    for a in range(4):
+        sub = (a + 0.5) / 4 - 0.5
+        for i in range(rows):
+            y = (np.float64(r0 + i) + sub - v) / ry
+            qy[i, a] = y * y
+        for j in range(cols):
+            x = (np.float64(c0 + j) + sub - u) / rx
+            qx[j, a] = x * x
+    ts = (t_ring, t_disc)
+    cov = np.empty(2)
+    for i in range(rows):
+        y_lo, y_hi = qy[i].min(), qy[i].max()
+        for j in range(cols):
+            hi = y_hi + qx[j].max()
+            lo = y_lo + qx[j].min()
+            for k in range(2):
+                t = ts[k]
+                if hi <= t:
+                    cov[k] = 1.0
+                elif lo > t:
+                    cov[k] = 0.0
+                else:
+                    n = 0
+                    for a in range(qy.shape[1]):
+                        for b in range(qx.shape[1]):
+                            n += qx[j, b] + qy[i, a] <= t
+                    cov[k] = n / 16
+            if np.float64(disp[r0 + i, c0 + j]) > nearer:
+                continue
+            ring, disc = cov[0], cov[1]
+            drawn = (np.float64(image[r0 + i, c0 + j]) * (1 - ring)
+                     + MARKER_LIGHT * (ring - disc) + MARKER_DARK * disc)
+            image[r0 + i, c0 + j] = drawn
+            if ring > 0.5:
+                disp[r0 + i, c0 + j] = d
+
+
+@njit(cache=True)
+def _draw_surface(image: np.ndarray, disp: np.ndarray, r0: int, r1: int, c0: int, c1: int,
+                  texture: np.ndarray, grey: float, d: float, weak: bool) -> None:
+    """Renderer._paint's drawing in one pass over rows r0:r1, columns c0:c1 of the whole image
+    and disparity: where the scene is not nearer (_nearer), the texture from its corner,
+    repeated where the box is larger (or the uniform grey where the texture is empty), and the
+    disparity d."""
+    nearer = _nearer(d, weak)
+    th, tw = texture.shape
+    for i in range(r1 - r0):
+        ti, tj = (i % th if th else 0), 0  # the texture's row and column (no % a pixel)
+        for j in range(c1 - c0):
+            if not np.float64(disp[r0 + i, c0 + j]) > nearer:  # NaN: no scene there
+                image[r0 + i, c0 + j] = texture[ti, tj] if th else grey
+                disp[r0 + i, c0 + j] = d
+            tj += 1
+            if tj == tw:
+                tj = 0
+
+
+_NO_TEXTURE = np.zeros((0, 1), np.float32)
+
+
+@njit(cache=True)
+def _nearer(d: float, weak: bool) -> float:
+    """d + NEARER_PX as numpy compared a float32 disparity map with it (`disp > d +
+    NEARER_PX`): rounded to float32 first when d is a Python float (weak: numpy takes it to the
+    array's type), not when it is a numpy float64."""
+    limit = d + NEARER_PX
+    return np.float64(np.float32(limit)) if weak else limit
+
+
 LensBounds = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
 
@@ -352,16 +435,12 @@ class Renderer:
         if c0 >= c1 or r0 >= r1:
             return
         self._touch(image, disp, r0, r1, c0, c1)
-        shown = ~(disp[r0:r1, c0:c1] > d + NEARER_PX)
-        if texture is not None:  # the texture from its corner, repeated where the box is larger
-            th, tw = texture.shape
-            surface = texture[:r1 - r0, :c1 - c0]
-            if r1 - r0 > th or c1 - c0 > tw:
-                surface = texture[np.arange(r1 - r0) % th][:, np.arange(c1 - c0) % tw]
-            np.copyto(image[r0:r1, c0:c1], surface, where=shown)
-        else:
-            image[r0:r1, c0:c1][shown] = 60.0
-        disp[r0:r1, c0:c1][shown] = d
+        # in one compiled pass, the same as:
+        #   shown = ~(disp[r0:r1, c0:c1] > d + NEARER_PX)
+        #   np.copyto(image[r0:r1, c0:c1], texture from its corner (tiled), where=shown), or
+        #   image[r0:r1, c0:c1][shown] = 60.0 without one; disp[r0:r1, c0:c1][shown] = d
+        _draw_surface(image, disp, r0, r1, c0, c1, _NO_TEXTURE if texture is None else texture,
+                      60.0, d, type(d + NEARER_PX) is float)
 
     def _marker(self, image: np.ndarray, disp: np.ndarray, u: float, v: float, rx: float,
                 ry: float, d: float, ring: float) -> None:
@@ -374,16 +453,16 @@ class Renderer:
         if c0 >= c1 or r0 >= r1:
             return
         self._touch(image, disp, r0, r1, c0, c1)
-        sub = (np.arange(4) + 0.5) / 4 - 0.5
-        qy = ((np.arange(r0, r1)[:, None] + sub - v) / ry) ** 2  # rows x 4 sub-rows
-        qx = ((np.arange(c0, c1)[:, None] + sub - u) / rx) ** 2  # columns x 4 sub-columns
-        ring_cov, disc_cov = _coverage(qx, qy, (ring * ring, 1.0))
-        patch = image[r0:r1, c0:c1]
-        shown = ~(disp[r0:r1, c0:c1] > d + NEARER_PX)
-        light = ring_cov - disc_cov
-        drawn = patch * (1 - ring_cov) + MARKER_LIGHT * light + MARKER_DARK * disc_cov
-        patch[shown] = drawn[shown]
-        disp[r0:r1, c0:c1][(ring_cov > 0.5) & shown] = d
+        # in one compiled pass, the same arithmetic as (tests/sim/test_render_kernels.py):
+        #   sub = (np.arange(4) + 0.5) / 4 - 0.5
+        #   qy = ((np.arange(r0, r1)[:, None] + sub - v) / ry) ** 2  # rows x 4 sub-rows
+        #   qx = ((np.arange(c0, c1)[:, None] + sub - u) / rx) ** 2  # columns x 4 sub-columns
+        #   ring_cov, disc_cov = _coverage(qx, qy, (ring * ring, 1.0))
+        #   shown = ~(disp[r0:r1, c0:c1] > d + NEARER_PX)
+        #   drawn = patch * (1 - ring_cov) + MARKER_LIGHT * light + MARKER_DARK * disc_cov
+        #   patch[shown] = drawn[shown]; disp[r0:r1, c0:c1][(ring_cov > 0.5) & shown] = d
+        _draw_marker(image, disp, r0, r1, c0, c1, u, v, rx, ry, ring * ring, 1.0, d,
+                     type(d + NEARER_PX) is float)
 
     # ------------------------------------------------------------------------------ views
 
