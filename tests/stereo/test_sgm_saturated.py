@@ -25,9 +25,10 @@ def test_saturated_packing_gives_the_plain_decision(paths, nd, uniqueness) -> No
     rng = np.random.default_rng(nd)
     h, w = 5, 40 + nd
     cost = rng.integers(0, 40, (h, w, nd)).astype(np.uint16)
-    # costs 0 .. 40 beside a raised band (every candidate costs 150 more): some pixels' totals
-    # all reach the saturation (their minimum at or over 0xFFFF >> bits), the others not
-    cost[:, w // 3: 2 * w // 3] += 150
+    # costs 0 .. 40, every candidate 150 more on the right half: there each pixel's totals all
+    # reach the saturation (their minimum at or over 0xFFFF >> bits), and so does each right
+    # pixel's diagonal from w / 2 on; on the left half neither
+    cost[:, w // 2:] += 150
     none = np.zeros((h, w), np.uint64)
     total = np.empty_like(cost)
     left, right = sgm.match(none, sgm.reversed_right(none, 2, nd), cost, total, 2,
@@ -36,6 +37,7 @@ def test_saturated_packing_gives_the_plain_decision(paths, nd, uniqueness) -> No
     top = 0xFFFF >> int(np.ceil(np.log2(nd)))
     least = total.min(axis=2)
     assert (least >= top).any() and (least < top).any()
+    assert (least[:, w // 2:] >= top).all()  # and so every right pixel from w / 2 - 2 on
     assert sgm._fused(0, nd, True)  # the fused sweep runs here, not the separate passes
     want_l, want_r = _decided(total, 2, uniqueness)
     np.testing.assert_array_equal(left, want_l)
