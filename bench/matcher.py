@@ -112,7 +112,8 @@ def pair_params(kind: str, nd: int, paths: int = OWN_SGM.paths) -> tuple[Matcher
     return own, lambda gl, gr: (lambda: compute_disparity(gl, gr, ref))
 
 
-def speed(kind: str, paths: tuple[int, ...] = (OWN_SGM.paths,)) -> None:
+def speed(kind: str, paths: tuple[int, ...] = (OWN_SGM.paths,),
+          sizes: list[tuple[int, int, int]] | None = None) -> None:
     """Rows of own / OpenCV at every size: CPU time on one thread, wall time on two."""
     other = "StereoBM" if kind == "sad" else "SGBM 3WAY"
     what = (f"own SAD (window {SAD_WINDOW}, default sub-pixel) / cv2.StereoBM" if kind == "sad"
@@ -120,7 +121,7 @@ def speed(kind: str, paths: tuple[int, ...] = (OWN_SGM.paths,)) -> None:
                  "fill)")
     what += ", grey" if kind == "sad" else ", colour pair (each matcher takes what it uses)"
     print(f"\n## {what}; CPU ms on 1 thread, wall ms on 2 threads")
-    for w, h, nd in SIZES:
+    for w, h, nd in SIZES if sizes is None else sizes:
         gl, gr = resized_pair(w, h, colour=kind == "sgm")
         for pth in paths:
             own, maker = pair_params(kind, nd, pth)
@@ -285,13 +286,31 @@ def parse(argv: list[str]) -> argparse.Namespace:
                     help="which to run (see below); default all but 'paths'")
     ap.add_argument("--blocks", type=int, default=BLOCKS,
                     help=f"alternating blocks per ratio, median taken (default {BLOCKS})")
+    ap.add_argument("--size", dest="sizes", action="append", metavar="WxH/ND", default=None,
+                    help="the speed sections at this size only, e.g. 640x480/96; repeat for "
+                         "more (default: the nine above)")
     args = ap.parse_args(argv)
     unknown = [v for v in args.sections if v not in SECTIONS]
     if unknown:
         ap.error(f"unknown section {unknown[0]!r} (choose from {', '.join(SECTIONS)})")
     if args.blocks < 1:
         ap.error(f"--blocks must be at least 1, got {args.blocks}")
+    if args.sizes is not None:
+        try:
+            args.sizes = [parse_size(v) for v in args.sizes]
+        except ValueError:
+            ap.error(f"--size takes WxH/ND (e.g. 640x480/64), got {' '.join(args.sizes)}")
     return args
+
+
+def parse_size(text: str) -> tuple[int, int, int]:
+    """'640x480/64' -> (640, 480, 64); ValueError unless all three are positive."""
+    wh, nd = text.split("/")
+    w, h = wh.split("x")
+    out = (int(w), int(h), int(nd))
+    if min(out) < 1:
+        raise ValueError(text)
+    return out
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -303,11 +322,11 @@ def main(argv: list[str] | None = None) -> int:
           f"cv2 {cv2.__version__}, numba {numba.__version__}, {BLOCKS} alternating blocks, "
           f"{load()}")
     if "sad" in only:
-        speed("sad")
+        speed("sad", sizes=args.sizes)
     if "sgm" in only:
-        speed("sgm")
+        speed("sgm", sizes=args.sizes)
     if "paths" in only:
-        speed("sgm", SGM_PATHS)
+        speed("sgm", SGM_PATHS, sizes=args.sizes)
     if "memory" in only:
         memory()
     set_threads(2)

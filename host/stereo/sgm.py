@@ -422,6 +422,18 @@ def _first_min(s, m, idx, n):
     return np.int64(best), np.float32(m)
 
 
+@njit(cache=True, inline="always")
+def _scan_min(s, n):
+    """(smallest j with s[j] the minimum of s[:n], that minimum): a plain loop."""
+    best = 0
+    m = s[0]
+    for j in range(1, n):
+        if s[j] < m:
+            m = s[j]
+            best = j
+    return np.int64(best), m
+
+
 @njit(cache=True, fastmath=True, inline="always")
 def _close(s, c0, uniqueness, best, nd):
     """Whether a candidate other than best and its two neighbours costs at most c0 * (1 +
@@ -631,7 +643,8 @@ def _from_the_right(crow, H, tot, mins, Z, p1, T, G, y, nd):
 
 
 @njit(cache=True, fastmath=True, inline="always")
-def _from_the_right_decided(crow, H, tot, fb, acc16, sh, idx, p1, T, G, y, nd, uniqueness):
+def _from_the_right_decided(crow, H, tot, fb, acc16, sh, sat, idx, p1, T, G, y, nd,
+                            uniqueness):
     """_from_the_right with the decision's passes over each pixel's totals in the same sweep,
     where every total fits with the candidate's bits below it (sh > 0), nd >= 16 and the right
     view is wanted: each total vector, as it is summed, is packed as total << sh | j, whose
@@ -640,11 +653,21 @@ def _from_the_right_decided(crow, H, tot, fb, acc16, sh, idx, p1, T, G, y, nd, u
     in lanes over the pixel's totals while they are in the cache. fb gets what _decide_row
     puts there; acc16 the right view's packed minima (_finish_row reads them). The separate
     passes (winner, uniqueness, right view) took 3.7, 3.6 and 3.1 ms of a 640x480 image at
-    16 to 64 candidates, whatever the count (issue 24)."""
+    16 to 64 candidates, whatever the count (issue 24).
+
+    Where a total may not fit beside the candidate (65 to 128 candidates at the defaults: a
+    total needs 10 bits, 128 candidates 7), each total is packed saturated at top = 0xFFFF >>
+    sh: a packed minimum under top is the exact one; a pixel whose every total reaches top
+    (its minimum reads top) takes its winner from a plain scan of its totals instead, and so
+    does a right pixel in _finish_row. So the maps are those of the separate passes. sat:
+    whether a total can saturate (else the packing and checks are left out: at 64 candidates
+    they cost 3-4 % of the call)."""
     w = crow.shape[0]
     m4 = np.uint16(0)
     shv = L.splat(np.uint16(sh))
     mask = np.uint16((1 << sh) - 1)
+    top = np.uint16(0xFFFF >> sh)
+    topv = L.splat(top)
     big = L.splat(np.uint16(0xFFFF))
     two = L.splat(np.uint16(2))
     acc16[:] = np.uint16(0xFFFF)
@@ -663,6 +686,8 @@ def _from_the_right_decided(crow, H, tot, fb, acc16, sh, idx, p1, T, G, y, nd, u
             # the overlapping last vector keeps the lanes already summed (as _sum_into)
             v = L.select_ge(j - b, L.vadd(old, L.load(h4, b + 1)), old)
             L.store(o, b, v)
+            if sat:
+                v = L.vmin(v, topv)
             pk = _vor(_vshl(v, shv), L.load(idx, b))
             lo = L.vmin(lo, pk)
             a = w - x + b
@@ -671,6 +696,9 @@ def _from_the_right_decided(crow, H, tot, fb, acc16, sh, idx, p1, T, G, y, nd, u
         packed = L.hmin(lo)
         best = np.int64(packed & mask)
         c0 = np.float32(packed >> np.uint16(sh))
+        if sat and packed >> np.uint16(sh) == top:  # all saturated: the plain first minimum
+            best, m = _scan_min(o, nd)
+            c0 = np.float32(m)
         fb[0, x] = best
         fb[2, x] = c0
         inner = 0 < best < nd - 1
@@ -693,14 +721,31 @@ def _from_the_right_decided(crow, H, tot, fb, acc16, sh, idx, p1, T, G, y, nd, u
 
 
 @njit(cache=True, fastmath=True, inline="always")
-def _finish_row(fb, y, dmin, fit, disp_l, disp_r, acc16, sh, rr, lr):
+def _finish_row(fb, tot, y, dmin, fit, disp_l, disp_r, acc16, sh, sat, rr, lr):
     """The rest of _decide_row after _from_the_right_decided: the left row from fb, the right
-    row from acc16's packed minima, the LR check."""
+    row from acc16's packed minima (a saturated one, at top: from a plain scan of its diagonal
+    in tot), the LR check."""
     w = fb.shape[1]
+    nd = tot.shape[1]
     _fit_row(fb, disp_l[y], dmin, fit, w)
     mask = np.uint16((1 << sh) - 1)
-    for xr in range(w - dmin):
-        rr[xr] = dmin + (acc16[w - dmin - xr] & mask)
+    top = np.uint16(0xFFFF >> sh)
+    if not sat:
+        for xr in range(w - dmin):
+            rr[xr] = dmin + (acc16[w - dmin - xr] & mask)
+    for xr in range(w - dmin if sat else 0):
+        e = acc16[w - dmin - xr]
+        if e >> np.uint16(sh) == top:
+            x0 = xr + dmin
+            bj = 0
+            m = tot[x0, 0]
+            for j in range(1, min(nd, w - x0)):
+                if tot[x0 + j, j] < m:
+                    m = tot[x0 + j, j]
+                    bj = j
+            rr[xr] = dmin + bj
+        else:
+            rr[xr] = dmin + (e & mask)
     if disp_r.shape[0] > 0:
         disp_r[y] = rr
     if lr >= 0.0:
@@ -709,8 +754,18 @@ def _finish_row(fb, y, dmin, fit, disp_l, disp_r, acc16, sh, rr, lr):
 
 @njit(cache=True, inline="always")
 def _fused(sh, nd, want_right):
-    """Whether the passes use _from_the_right_decided (see there)."""
-    return sh > 0 and nd >= L.LANES and want_right
+    """The candidate's bits in _from_the_right_decided's packing, or 0 where the passes take the
+    separate decision (_decide_row): below 16 candidates, without the right view, and above
+    FUSED_MAX candidates unless every total fits beside the candidate (sh > 0)."""
+    bits = 0
+    while (1 << bits) < nd:
+        bits += 1
+    if nd < L.LANES or not want_right or not (sh > 0 or nd <= FUSED_MAX):
+        return 0
+    return bits
+
+
+FUSED_MAX = 128  # saturated totals keep 9 bits at 128 candidates (top 511)
 
 
 OVERLAP = 24  # rows the lower stripe of the 5-path pass starts above its first row
@@ -734,7 +789,7 @@ def _down(cl, crrev, gl, gr, vol, pl, prrev, term, S, P, M, crow, tot, y0, y1, w
     nd = crow.shape[1]
     cs = _census_scratch(gl, dmin, nd)
     idx, jj, fb, mins, Z, H, rr = _row_scratch(w, nd)
-    fused = _fused(sh, nd, want_right)
+    fsh = _fused(sh, nd, want_right)
     for i in range(y1 - y0 + warm):
         y = y0 - warm + i
         decided = i >= warm
@@ -770,10 +825,10 @@ def _down(cl, crrev, gl, gr, vol, pl, prrev, term, S, P, M, crow, tot, y0, y1, w
             _sum_into(tot[x], Z, h0, d1, v2, d3, nd, False)
         if not decided:
             continue
-        if fused:
-            _from_the_right_decided(crow, H, tot, fb, acc16, sh, idx, p1, T, G, y, nd,
-                                    uniqueness)
-            _finish_row(fb, y, dmin, fit, disp_l, disp_r, acc16, sh, rr, lr)
+        if fsh:
+            _from_the_right_decided(crow, H, tot, fb, acc16, fsh, sh == 0, idx, p1, T, G, y,
+                                    nd, uniqueness)
+            _finish_row(fb, tot, y, dmin, fit, disp_l, disp_r, acc16, fsh, sh == 0, rr, lr)
         else:
             _from_the_right(crow, H, tot, mins, Z, p1, T, G, y, nd)
             _decide_row(tot, mins, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc,
@@ -838,7 +893,7 @@ def _four(cl, crrev, gl, gr, vol, pl, prrev, term, S, y0, y1, K, ck, ckm, top, t
     nd = ck.shape[2]
     cs = _census_scratch(gl, dmin, nd)
     idx, jj, fb, mins, Z, H, rr = _row_scratch(w, nd)
-    fused = _fused(sh, nd, want_right)
+    fsh = _fused(sh, nd, want_right)
     P = np.empty((2, w, nd + 2), dtype=np.uint16)
     P[:, :, 0] = PAD
     P[:, :, nd + 1] = PAD
@@ -912,10 +967,10 @@ def _four(cl, crrev, gl, gr, vol, pl, prrev, term, S, y0, y1, K, ck, ckm, top, t
                 m0 = _start(h0, c, nd) if x == 0 else _step(H[1 - x % 2], m0, h0, c, p1,
                                                             _pen(T, G, y, x, y, x - 1), nd)
                 _sum_into(tot[x], Z, h0, v, BB[r, x], Z, nd, False)
-            if fused:
-                _from_the_right_decided(crow, H, tot, fb, acc16, sh, idx, p1, T, G, y, nd,
-                                        uniqueness)
-                _finish_row(fb, y, dmin, fit, disp_l, disp_r, acc16, sh, rr, lr)
+            if fsh:
+                _from_the_right_decided(crow, H, tot, fb, acc16, fsh, sh == 0, idx, p1, T,
+                                        G, y, nd, uniqueness)
+                _finish_row(fb, tot, y, dmin, fit, disp_l, disp_r, acc16, fsh, sh == 0, rr, lr)
             else:
                 _from_the_right(crow, H, tot, mins, Z, p1, T, G, y, nd)
                 _decide_row(tot, mins, y, dmin, uniqueness, fit, want_right, disp_l, disp_r,
