@@ -104,12 +104,6 @@ class ControlConfig:
     # that line's bearing from the axis): the card's aspect is noisy near square (0.98 reads
     # 11.5 degrees), one sighting alone is not taken
     reach_frames: int = 10
-    # creeping beside an object (its extent known) with the card showing the body turned
-    # (reach_m this far beyond half the width, ~8 degrees or more), the wheels' trim is not
-    # steered: learnt at drive speed, near the dead zone it turned the creeping body 21 to 42
-    # degrees (dev 105 #6 in 3 s; dev 1 #2 to the card edge-on), each degree widening the
-    # reach every check takes; the creep goes straight on the wheels as they are
-    creep_trim_reach_m: float = 0.01
     clearance_m: float = 0.15  # the lane's distance from the object's side: half the body,
     # and room for the lateral hold error and a sideways drift while holding
     block_m: float = 0.15  # within this depth of the object, the body must be clear of it
@@ -549,9 +543,7 @@ class Controller:
             # steering against it turns the robot off the card's visible range and, near the
             # dead zone, spins it in place; only the wheels' trim acts there
             steer = (0.0 if creeping else max(-abs(duty) / 2, min(abs(duty) / 2, pd)))
-            if not (creeping and self.keep_out is not None
-                    and self.reach_m() - cfg.half_width_m >= cfg.creep_trim_reach_m):
-                steer += self.trim * duty
+            steer += self.trim * duty
         self.phase = Phase.CREEP if creeping else Phase.DRIVE
         left, right = duty - steer, duty + steer
         if obs.lateral_m is not None and self._near_end(z, obs.lateral_m, left, right):
