@@ -101,6 +101,7 @@ from host.servo.recovery import (
     BackOff,
     BackOffConfig,
     Recovery,
+    away_by_heading,
     lane_steer,
     servo_bounds,
     settled_on,
@@ -1132,7 +1133,10 @@ class Servo:
         settled = settled_on(lateral, lane, 0.0 if st is None else st.vx, b.cfg)
         left, right = b.update(t, depth, gap, c.target_m, self.tracker_confirmed, c.facing_away,
                                c.trim, pushed, c.floor, steer, settled,
-                               c.reach_m() - c.cfg.half_width_m)  # turned as the card shows
+                               c.reach_m() - c.cfg.half_width_m,  # turned as the card shows
+                               # its first way: the one its line takes away from the side
+                               away_by_heading(self.heading.value, self.heading.spread,
+                                               lateral, c.keep_out, b.cfg))
         if b.outcome == DONE:
             rec.update(t, True)
             self.backoff = None

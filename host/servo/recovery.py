@@ -183,6 +183,21 @@ class BackOffConfig:
     camera_room_m: float = 0.05
     lane_m: float = 0.01
     lane_mps: float = 0.01
+    # the body's line this far or more off the depth axis (and beyond the heading's spread),
+    # beside the object (not in front of its face by level_m): the first way is the one its
+    # line takes away from the object's side (away_by_heading), not the one by depth alone
+    # (dev seed 3 #4: 2.6 cm beyond the face, turned 21 degrees toward the side, it backed
+    # off deeper and closed 1.7 cm on the side in 0.5 s: stopped, no safe way back)
+    heading_min: float = math.radians(5)
+    # the card showing the body turned (turned_m this far beyond half the width, ~8 degrees
+    # or more), its line's closing is told from turned_turn_m of shrink, not turn_m: the way
+    # is known turned one way or the other, and the 1 cm a push alone might close came too
+    # late (#3/4: the heading unknown, spread 13 degrees, the flip due at 1 cm was one frame
+    # behind the corner rule's stop). Only the first way: it flips sooner (the other way is
+    # judged as ever); the second starts while the body still coasts the first way (#3/4:
+    # 5 mm there stopped it, closing either way)
+    turned_reach_m: float = 0.01
+    turned_turn_m: float = 0.005
     corner_m: float = 0.033  # the body's half diagonal less its half width (0.113 - 0.08):
     # how far a corner of a body turned any way reaches beyond the side the gap is reckoned
     # for. Level with the face, closing, the other way runs the body past the object's end:
@@ -240,7 +255,7 @@ class BackOff:
     def update(self, t: float, z: float | None, gap: float | None, target_m: float,
                confirmed: bool, facing_away: bool, trim: float,
                pushed_m: float = 0.0, floor: int = 0, steer: float = 0.0,
-               settled: bool = True, turned_m: float = 0.0) -> tuple[int, int]:
+               settled: bool = True, turned_m: float = 0.0, away: int = 0) -> tuple[int, int]:
         """z: the robot's depth this frame at t (None: not seen, it stands; unseen unseen_s
         once it has moved, the back-off ends: the re-acquisition looks for the card, its
         spin checked as any); gap: the body's clearance across from the object's extent
@@ -261,7 +276,10 @@ class BackOff:
         how much farther across than half its width the body reaches, turned as the card
         shows it (the controller's reach_m less half_width_m): every rule judges the gap
         less it, but for the pass by the end (corner_m: the half diagonal's reach, any turn,
-        beyond half the width: already the most a turn adds)."""
+        beyond half the width: already the most a turn adds). away: +1 backing off deeper
+        takes the body's line away from the object's side, -1 toward it, 0 not known
+        (away_by_heading): beside the object (not level_m in front of its face) the first way
+        is the one away from the side; the rules that follow judge it as any way."""
         raw = gap
         gap = None if gap is None else gap - max(0.0, turned_m)
         if z is not None:
@@ -280,6 +298,8 @@ class BackOff:
         first = self.start_z is None
         if first:
             self.deeper, self.start_z, self.start_gap = e > cfg.beyond_m, z, gap
+            if away and e > -cfg.level_m:
+                self.deeper = away > 0
         out = self.block_m + (0.0 if first else cfg.clear_m)
         if abs(e) >= out and (first or self.deeper or settled or self._settle_spent(z, e)):
             self.outcome = DONE  # out of the object's depth (measured again: never in it)
@@ -288,7 +308,9 @@ class BackOff:
         # closing on the side as it goes: turned toward it (a push alone closes far less
         # per metre of depth travelled)
         shrunk = 0.0 if gap is None or self.start_gap is None else self.start_gap - gap
-        closing = shrunk > max(cfg.turn_m, cfg.turned * abs(z - self.start_z))
+        least = cfg.turned_turn_m if turned_m >= cfg.turned_reach_m and not self.flipped \
+            else cfg.turn_m  # the second way starts coasting the first: turn_m as ever
+        closing = shrunk > max(least, cfg.turned * abs(z - self.start_z))
         # level with the object's face (within level_m of its depth) or behind it, the
         # body's side can reach the object's: a real object's sides run back from its face
         # for a depth the camera does not see (the simulation's box is its face alone; the
@@ -332,6 +354,25 @@ class BackOff:
         bend = 0.0 if beside else max(-abs(d) / 2, min(abs(d) / 2, steer))
         left, right = lifted(d * (1 - trim) - bend, d * (1 + trim) + bend, floor, d)
         return int(round(left)), int(round(right))
+
+
+def away_by_heading(heading: float | None, spread: float, lateral_m: float | None,
+                    keep_out: tuple[float, float] | None,
+                    cfg: BackOffConfig = BackOffConfig()) -> int:
+    """Which way in depth the body's line takes it away from the object's side: +1 deeper
+    (away from the camera), -1 toward the camera, 0 not known (no heading, the line within
+    heading_min or its spread of the depth axis, no extent, or the body across it). heading:
+    the robot's travel (rad from +z toward +x, clearance.Heading), either way along it."""
+    if heading is None or lateral_m is None or keep_out is None:
+        return 0
+    x0, x1 = keep_out
+    if x0 <= lateral_m <= x1:
+        return 0
+    slope = math.tan(heading)  # x gained per metre deeper along the line, either way
+    if abs(math.atan(slope)) <= max(cfg.heading_min, spread):
+        return 0
+    side = 1 if lateral_m > x1 else -1  # away from the side is this way in x
+    return 1 if slope * side > 0 else -1
 
 
 def settled_on(lateral_m: float | None, lane_m: float | None, vx_mps: float,
