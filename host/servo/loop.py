@@ -68,6 +68,7 @@ from host.servo.perception import (
     Floor,
     StripMap,
     Target,
+    bias_shrunk,
     camera_height,
     corrected_right,
     fit_floor,
@@ -77,6 +78,7 @@ from host.servo.perception import (
     in_view,
     lane_obstacle,
     lane_window,
+    lens_shaped,
     match_exposure,
     match_window,
     median_map,
@@ -400,14 +402,21 @@ class Servo:
         self._width = w
         target, self.floor = reference_target(disps, min_area)
         bias = floor_column_bias(median_map(disps), self.floor)
-        if bias is not None and abs(bias.largest) >= BIAS_LIMIT_PX:
-            # the calibration is off at some columns: the reference again on corrected views
+        if bias is not None and abs(bias.largest) >= BIAS_LIMIT_PX and lens_shaped(bias):
+            # the calibration is off at the picture's edge: the reference again on corrected
+            # views, kept only if the floor's leftover measured on them shrank (issue 23)
             self.column_bias = bias
-            self.notes.append(bias.describe())
-            frames = [self._unbiased(g) for g in frames]
-            f = frames[-1]
-            disps = [compute_disparity(g.left, g.right, self.params) for g in frames]
-            target, self.floor = reference_target(disps, min_area)
+            fixed = [self._unbiased(g) for g in frames]
+            fixed_disps = [compute_disparity(g.left, g.right, self.params) for g in fixed]
+            fixed_target, fixed_floor = reference_target(fixed_disps, min_area)
+            if bias_shrunk(bias, floor_column_bias(median_map(fixed_disps), fixed_floor)):
+                self.notes.append(bias.describe())
+                frames, disps, f = fixed, fixed_disps, fixed[-1]
+                target, self.floor = fixed_target, fixed_floor
+            else:
+                self.column_bias = None
+                self.notes.append(f"the floor reads {bias.largest:+.2f} px of column bias, "
+                                  "not corrected: the corrected views' leftover did not shrink")
         self._measure_height(self.floor)
         self.reference_map = median_map(disps)
         k = self._lane_scale = max(1, w // self.cfg.lane_width_px)
