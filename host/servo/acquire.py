@@ -239,7 +239,18 @@ class Acquisition:
         return True
 
     def resume(self) -> None:
-        """The pause is over (the move checked again and clear, or the refusal stands)."""
+        """The pause is over (the move checked again and clear, or the refusal stands). The
+        probe begins its track again at the next frame (as interrupted's): its sightings
+        from before the stand against those after would count a push while it stood (a
+        person's knock, a hand setting it straight) as the probe's move. Its driving time
+        stays: to the last sighting before the stand and the stand's first run_down_s (the
+        gap rule's count, the stand lasting settle_s at least)."""
+        if self.paused_t is not None and self.phase == Phase.PROBE and self._t0 is not None:
+            if self._track:
+                self.spent_s = self.driven_s() + self.cfg.run_down_s
+            self._track.clear()
+            self._disp.clear()
+            self._t0 = None  # the probe's clock starts again at the next frame
         self.paused_t = None
 
     def refused(self, why: str) -> bool:
@@ -349,6 +360,7 @@ class Acquisition:
                 self._after.clear()
             self._track.clear()
             self._disp.clear()
+            self.paused_t = None  # a stand cut short: the probe begins again from the start
             # the last drive order was in force until this frame (the robot stands from it):
             # its time is driven, and the ledger holds it (dropped, a second leg cut by a
             # stale frame backed that frame's travel once more, beyond the start by it)

@@ -82,6 +82,11 @@ class RereferenceLimits:
     moved_frac: float = 0.35  # of the target's disparity: the farthest a target found at its
     # place by two tries running (rereference_fault's earlier) may have moved in depth (the
     # tracker's TrackerConfig.same_depth: farther, and it is another object)
+    width_factor: float = 2.0  # a target moved in depth (target_moved) keeps its width scaled
+    # by the disparities' ratio within this factor either way (a narrower object nearer, in
+    # front of the box, does not scale so: a person's legs, a chair). Measured on the dev
+    # knock+move trials held by target_moved at 3a87aef (seeds 1:108 2:29 3:39 5:60 5:179
+    # 6:194 7:8 8:184): new width / (old width * d_new / d_old) 0.580-1.323
 
 
 def floor_follows_picture(floor_px: float, shift_rows: float, floor: Floor,
@@ -202,11 +207,7 @@ def rereference_fault(old_floor: Floor | None, floor: Floor, shift_rows: float, 
         return (f"the target's picture moved {target_rows:+.0f} rows where the picture moved "
                 f"{shift_rows:+.1f}" if math.isfinite(target_rows) else
                 "the target's picture is not where the picture's shift puts it")
-    def near(d: float) -> bool:
-        return abs(new.disparity - d) <= max(lim.disparity_px, lim.disparity_frac * d)
-
-    if not (near(old.disparity) or last is not None and near(last)
-            or target_moved(old, new, earlier, lim)):
+    if other_depth(old, new, last, lim) and not target_moved(old, new, earlier, lim):
         return (f"the nearest object is at {new.disparity:.2f} px, the target was at "
                 f"{old.disparity:.2f} px")
     ox, oy, ow, oh = old.bbox
@@ -222,15 +223,32 @@ def rereference_fault(old_floor: Floor | None, floor: Floor, shift_rows: float, 
     return ""
 
 
+def other_depth(old: Target, new: Target, last: float | None = None,
+                limits: RereferenceLimits = RereferenceLimits()) -> bool:
+    """Whether new is at another disparity than the target old's (the median of the tracker's
+    measures) and than last (its newest measure, None: none): a re-reference that takes it
+    takes the target moved in depth (target_moved), and the loop keeps old among the targets
+    a nearer object replaced (it may be an object in front of the target after all)."""
+    lim = limits
+
+    def near(d: float) -> bool:
+        return abs(new.disparity - d) <= max(lim.disparity_px, lim.disparity_frac * d)
+
+    return not (near(old.disparity) or last is not None and near(last))
+
+
 def target_moved(old: Target, new: Target, earlier: Target | None,
                  limits: RereferenceLimits = RereferenceLimits()) -> bool:
     """Whether new, found by a re-reference at another disparity than the target old had, is
     the target moved in depth: earlier (the previous try's find, None: no previous try)
     found at new's disparity (within limits' disparity_px or disparity_frac) and overlapping
     new by limits.overlap across and down (two tries running saw the same object still, not a
-    person passing, nor a phantom), and new within limits.moved_frac of old's disparity (the
-    tracker follows a move no larger). Where it stands (old's place moved by the picture) and
-    what it shows (its picture, its views) are rereference_fault's own checks."""
+    person passing, nor a phantom), new within limits.moved_frac of old's disparity (the
+    tracker follows a move no larger), and new's width old's scaled by the disparities'
+    ratio within limits.width_factor (a box moved in depth looks wider or narrower with it;
+    a narrower object nearer in front of it, which span_overlap's share of the narrower
+    region places where the box was, does not). Where it stands (old's place moved by the
+    picture) and what it shows (its picture, its views) are rereference_fault's own checks."""
     if earlier is None:
         return False
     lim = limits
@@ -239,6 +257,10 @@ def target_moved(old: Target, new: Target, earlier: Target | None,
         return False
     if not abs(new.disparity - old.disparity) <= lim.moved_frac * old.disparity:
         return False
+    ow, nw = old.bbox[2], new.bbox[2]
+    scaled = ow * new.disparity / old.disparity  # the old target's width at new's depth
+    if not scaled / lim.width_factor <= nw <= scaled * lim.width_factor:
+        return False  # not the target's width at its new depth: another object in front
     ex, ey, ew, eh = earlier.bbox
     nx, ny, nw, nh = new.bbox
     return (span_overlap(ex, ex + ew, nx, nx + nw) >= lim.overlap

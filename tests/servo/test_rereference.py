@@ -90,8 +90,9 @@ def test_a_target_moved_in_depth_found_so_by_two_tries_running_is_a_re_reference
     far = Target(26.0, 6100, (22, 67, 89, 76), 0.1)
     assert not target_moved(TARGET, far, far)
     assert rereference_fault(OLD_FLOOR, floor, UP, TARGET, far, 0.9, earlier=far) != ""
-    # found twice, but not where the target was: its place still refuses it
-    elsewhere = Target(20.8, 2000, (218, 128, 47, 26), 0.07)
+    # found twice, but not where the target was: its place still refuses it (its width the
+    # target's at that depth, else target_moved refuses it already)
+    elsewhere = Target(20.8, 2600, (200, 128, 100, 26), 0.07)
     why = rereference_fault(OLD_FLOOR, floor, UP, TARGET, elsewhere, 0.9, earlier=elsewhere)
     assert why.startswith("the nearest object is not where the target was"), why
     # its picture not moved with the picture's shift, or its views disagreeing: refused
@@ -261,3 +262,26 @@ def test_a_nearer_region_whose_views_disagree_is_passed_over():
                                  agree) != ""
     with pytest.raises(HostError):  # nothing agrees: no object
         nearest_agreeing(disp, 1000, lambda t: -0.05)
+
+
+def test_a_narrower_object_nearer_in_front_of_the_target_twice_is_no_re_reference():
+    """The reviewer's (issue 23): after the knock a narrower object 30 % nearer stands in the
+    box's columns (a person's legs, a chair in front of the box) at 22.6 px, then 22.8, the
+    box's picture still found moved with the picture, its views agreeing. span_overlap's
+    share of the narrower region puts it where the box was; two tries running took it as the
+    box moved (and the keep-out became its extent). A box that moved so looks wider with its
+    disparity (89 px at 17.5 -> ~116 at 22.8); the legs stay 30 px: refused, both tries."""
+    floor = _pitched(OLD_FLOOR, UP)
+    first = Target(22.6, 2100, (50, 60, 30, 90), 0.1)
+    legs = Target(22.8, 2150, (51, 60, 30, 90), 0.1)
+    for earlier, found in ((None, first), (first, legs)):
+        why = rereference_fault(OLD_FLOOR, floor, UP, TARGET, found, 0.9, target_rows=UP,
+                                earlier=earlier)
+        assert why.startswith("the nearest object is at"), why
+    assert not target_moved(TARGET, legs, first)
+    # the box itself moved so (its width scaled with the disparity): taken, as before
+    box1 = Target(22.6, 8800, (12, 62, 112, 98), 0.1)
+    box2 = Target(22.8, 8900, (10, 61, 116, 99), 0.1)
+    assert target_moved(TARGET, box2, box1)
+    assert rereference_fault(OLD_FLOOR, floor, UP, TARGET, box2, 0.9, target_rows=UP,
+                             earlier=box1) == ""
