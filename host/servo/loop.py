@@ -114,6 +114,7 @@ from host.servo.rereference import (
     fill_hidden,
     floor_follows_picture,
     nearest_agreeing,
+    other_depth,
     refit_floor,
     rereference_fault,
     target_shift_rows,
@@ -1374,8 +1375,13 @@ class Servo:
         self._reference_image = reference_image(frame.left)
         self._target_picture = (self._reference_image, robot)
         self._lane_reference = self._lane_map(reference)
+        moved = other_depth(old, target, self.tracker.history[-1])
         self.tracker = TargetTracker(target, self.tracker.min_area, self.cfg.tracker)
-        self._targets_before.clear()
+        if moved:  # taken as the target moved in depth (rereference.target_moved): it may be
+            # an object in front of it after all, the target kept to go back to when it goes
+            self._targets_before.append(old)
+        else:
+            self._targets_before.clear()
         self.controller.target_m = self.geometry.depth_m(target.disparity)
         self.controller.keep_out = self._extent(
             object_extent(without_floor(reference, floor), target))
