@@ -1299,6 +1299,7 @@ class Servo:
         c.cfg, c.keep_out, c.trim, c.facing_away = old.cfg, old.keep_out, old.trim, \
             old.facing_away
         c.fixed, c.kept = old.fixed, old.kept
+        c.turns = list(old.turns)  # the body's turn as the card showed it (reach_m)
         self.controller = c
         self._cmd = Command(0, 0, Phase.WAIT, None)
         # the drives, turns and losses before it belong to a heading the probe sets afresh
