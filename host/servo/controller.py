@@ -99,10 +99,10 @@ class ControlConfig:
     trim_gain: float = 0.004  # learnt wheel trim, fraction of duty per cm of drift per second
     max_trim: float = 0.25
     half_width_m: float = 0.08  # the robot's body, centre to side (square to the camera axis)
-    # the body's reach across x turned (reach_m): the larger of the medians of the last
-    # reach_frames and of the last three sightings' turn bounds (the card's turn from its
-    # line of sight, acos of its aspect, and that line's bearing from the axis): the card's
-    # aspect is noisy near square (0.98 reads 11.5 degrees), one sighting alone is not taken
+    # the body's reach across x turned (reach_m): the median of the last reach_frames
+    # sightings' turn bounds (the card's turn from its line of sight, acos of its aspect, and
+    # that line's bearing from the axis): the card's aspect is noisy near square (0.98 reads
+    # 11.5 degrees), one sighting alone is not taken
     reach_frames: int = 10
     clearance_m: float = 0.15  # the lane's distance from the object's side: half the body,
     # and room for the lateral hold error and a sideways drift while holding
@@ -417,22 +417,20 @@ class Controller:
 
     def reach_m(self) -> float:
         """Half the body's extent across x (m), the rectangle (half_width_m across,
-        half_length_m along) turned by the larger of the medians of the recent sightings'
-        turn bounds and of the last three (saw), never less than half its width (nothing
-        seen: square). Every check of the body beside the object takes it (overlaps,
-        closing, the back-off's gap): turned 29 degrees past a turn round, seed 16 #470's
-        body reached 10.8 cm across, not the 8 the checks took, and its edge walked into the
-        side of the box it held beside (issue 23)."""
+        half_length_m along) turned by the median of the recent sightings' turn bounds
+        (saw), never less than half its width (nothing seen: square). Every check of the
+        body beside the object takes it (overlaps, closing, the back-off's gap): turned 29
+        degrees past a turn round, seed 16 #470's body reached 10.8 cm across, not the 8 the
+        checks took, and its edge walked into the side of the box it held beside (issue 23)."""
         cfg = self.cfg
         if not self.turns:
             return cfg.half_width_m
         # the most a rectangle reaches across is at its diagonal's angle: beyond that a
         # bound on the turn bounds the reach by the diagonal's
-        # the median of the last three too, the larger: a turn that has just come shows in
-        # three sightings, not in the six a median of ten waits for (29 degrees after ten square
-        # sightings: 8.0 cm for four sightings with the ten's median alone)
-        turn = max(float(np.median(self.turns)), float(np.median(self.turns[-3:])))
-        a = min(turn, math.atan2(cfg.half_length_m, cfg.half_width_m))
+        # (a turn that has just come shows in the median of ten by its sixth sighting; the
+        # median of the last three too, the larger, read the lane steer's passing turns and
+        # blocked the closed-loop back-off's and the clearance's holds: session 10)
+        a = min(float(np.median(self.turns)), math.atan2(cfg.half_length_m, cfg.half_width_m))
         return max(cfg.half_width_m,
                    cfg.half_width_m * math.cos(a) + cfg.half_length_m * math.sin(a))
 
