@@ -57,6 +57,11 @@ def sf(self, t, cmd):
                 f" | reach_m {reach:.4f} turns(deg) {turns}"
             )
             print(f"  keep_out {c.keep_out} target {c.target_m:.3f}")
+            e = self.estimator
+            since = None if e._stopped_since is None else round(t - e._stopped_since, 2)
+            fit = c.drift() if hasattr(c, "drift") else None
+            print(f"  rate learnt while driven {e._driven_rate}, standing for {since} s;"
+                  f" the hold's fit (t, x, rate) {fit}")
             print(
                 f"  truth x {r.x_m:+.4f} z {r.z_m:.3f} theta {math.degrees(r.theta):+.1f}"
                 f" half-across {hx:.4f} true gap {g:+.4f}; box {w.boxes[0]}"
