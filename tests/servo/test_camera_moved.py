@@ -50,3 +50,25 @@ def test_a_knocked_camera_is_still_a_moved_camera(pitch: float) -> None:
         frame = sim.source.read()
         servo._remeasure(_map(servo, frame), frame)
         assert servo.recovery.kind == MOVED
+
+
+def test_a_knock_whose_floor_rows_are_covered_is_a_moved_camera_at_the_second_remeasure(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """Seed 17's trial 604: knocked 12.5 rows (up) during a freeze, the box's bottom edge then
+    covered most of the reference's floor rows (the floor read -2.0 px for the -3.0 the pitch
+    gives: floor_follows_picture False, patched in here), and the old fit's floor strip at the
+    bottom (23.18 px) became the target for the box (20.78): held 15.6 cm short. The picture's
+    own shift, the same at two re-measures running, is a moved camera; the first takes no
+    target from its map."""
+    monkeypatch.setattr(loop, "floor_follows_picture", lambda *args, **kw: False)
+    with simulation(Setup(start_z_m=0.71, seed=2)) as sim:
+        servo = sim.servo
+        assert servo.tracker is not None
+        before = servo.tracker.target
+        sim.source.renderer.pitch_deg -= 1.67
+        for i in range(2):
+            frame = sim.source.read()
+            servo._remeasure(_map(servo, frame), frame)
+            assert servo.tracker.target.disparity == pytest.approx(before.disparity)
+            assert servo.recovery.kind == ("" if i == 0 else MOVED)
+        assert not servo.stop_reason
