@@ -32,6 +32,7 @@ def test_a_walker_over_the_floors_rows_read_as_a_shift_is_no_moved_camera(
         servo = sim.servo
         sim.world.people = (Person(-0.06, 0.87),)
         frame = sim.source.read()
+        assert frame is not None
         disp = _map(servo, frame)
         assert "camera moved" in camera_moved(disp, servo.floor, reference=servo.reference_map)
         monkeypatch.setattr(loop, "vertical_shift_px", lambda ref, image: 2.9)
@@ -48,6 +49,7 @@ def test_a_knocked_camera_is_still_a_moved_camera(pitch: float) -> None:
         servo = sim.servo
         sim.source.renderer.pitch_deg += pitch
         frame = sim.source.read()
+        assert frame is not None
         servo._remeasure(_map(servo, frame), frame)
         assert servo.recovery.kind == MOVED
 
@@ -68,6 +70,7 @@ def test_a_knock_whose_floor_rows_are_covered_is_a_moved_camera_at_the_second_re
         sim.source.renderer.pitch_deg -= 1.67
         for i in range(2):
             frame = sim.source.read()
+            assert frame is not None
             servo._remeasure(_map(servo, frame), frame)
             assert servo.tracker.target.disparity == pytest.approx(before.disparity)
             assert servo.recovery.kind == ("" if i == 0 else MOVED)
