@@ -111,6 +111,7 @@ from host.servo.recovery import (
 from host.servo.recovery import OUTSIDE as OUTSIDE_KIND
 from host.servo.refind import FOUND, WHOLE, LostCard, Refind, RefindConfig
 from host.servo.rereference import (
+    RereferenceLimits,
     fill_hidden,
     floor_follows_picture,
     nearest_agreeing,
@@ -316,6 +317,8 @@ class Servo:
                                               self.cfg.lane_stop_s))
         self._reref: list[np.ndarray] = []  # the re-reference's maps so far (robot left out)
         self._reref_fails = 0  # re-references that failed, in this wait
+        self._shifted: list[float] = []  # the picture's shift at the re-measures running
+        # that found it moved without the floor following (issue 23, seed 17's 604)
         self._reref_found: Target | None = None  # the nearest object the last try found
         self._targets_before: list[Target] = []  # the targets a nearer object replaced
         self.progress = Progress(self.cfg.progress)  # no progress for long: the run ends
@@ -586,6 +589,22 @@ class Servo:
                 self._reref, self._reref_fails, self._reref_found = [], 0, None
                 self._recover(frame.t_left, MOVED, f"{moved} (the picture moved {dy:+.1f} rows)")
                 return
+            if abs(dy) >= limit and self._cmd.phase != Phase.STALE:
+                # the picture moved but the floor's rows do not say so (the object covers
+                # most of them: seed 17's 604, a box's bottom edge knocked 12.5 rows down over
+                # the reference's floor rows read -2.0 px for -3.0): no target from this map (its
+                # floor is the old fit's: a floor strip would pass for the object), and the
+                # same shift at the next re-measure is a moved camera, not a walker's frame
+                self._shifted.append(dy)
+                if len(self._shifted) >= 2 and abs(self._shifted[-1] - self._shifted[-2]) <= \
+                        RereferenceLimits().horizon_rows:
+                    self._shifted = []
+                    self._reref, self._reref_fails, self._reref_found = [], 0, None
+                    self._recover(frame.t_left, MOVED, (
+                        f"the picture moved {dy:+.1f} rows at two re-measures running (the "
+                        f"floor's rows, {moved or 'on their fit'}, covered): the camera moved"))
+                return
+            self._shifted = []
             if abs(dy) < limit:
                 # the target's picture while the camera is where it was (a moved camera that
                 # the floor did not show yet must not give the picture the knock is measured

@@ -32,6 +32,7 @@ def test_a_walker_over_the_floors_rows_read_as_a_shift_is_no_moved_camera(
         servo = sim.servo
         sim.world.people = (Person(-0.06, 0.87),)
         frame = sim.source.read()
+        assert frame is not None
         disp = _map(servo, frame)
         assert "camera moved" in camera_moved(disp, servo.floor, reference=servo.reference_map)
         monkeypatch.setattr(loop, "vertical_shift_px", lambda ref, image: 2.9)
@@ -48,5 +49,29 @@ def test_a_knocked_camera_is_still_a_moved_camera(pitch: float) -> None:
         servo = sim.servo
         sim.source.renderer.pitch_deg += pitch
         frame = sim.source.read()
+        assert frame is not None
         servo._remeasure(_map(servo, frame), frame)
         assert servo.recovery.kind == MOVED
+
+
+def test_a_knock_whose_floor_rows_are_covered_is_a_moved_camera_at_the_second_remeasure(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """Seed 17's trial 604: knocked 12.5 rows (up) during a freeze, the box's bottom edge then
+    covered most of the reference's floor rows (the floor read -2.0 px for the -3.0 the pitch
+    gives: floor_follows_picture False, patched in here), and the old fit's floor strip at the
+    bottom (23.18 px) became the target for the box (20.78): held 15.6 cm short. The picture's
+    own shift, the same at two re-measures running, is a moved camera; the first takes no
+    target from its map."""
+    monkeypatch.setattr(loop, "floor_follows_picture", lambda *args, **kw: False)
+    with simulation(Setup(start_z_m=0.71, seed=2)) as sim:
+        servo = sim.servo
+        assert servo.tracker is not None
+        before = servo.tracker.target
+        sim.source.renderer.pitch_deg -= 1.67
+        for i in range(2):
+            frame = sim.source.read()
+            assert frame is not None
+            servo._remeasure(_map(servo, frame), frame)
+            assert servo.tracker.target.disparity == pytest.approx(before.disparity)
+            assert servo.recovery.kind == ("" if i == 0 else MOVED)
+        assert not servo.stop_reason
