@@ -125,12 +125,13 @@ class TargetTracker:
                   ) -> Target | None:
         """The target where it was while something else is nearest (its map spoilt elsewhere
         by flicker, a nearer object not yet vouched for): the nearest object in its columns
-        among the disparities within same_depth of its own, agreeing in both views; None if
-        there is none. Its views must agree as the whole map's target's must."""
+        among the disparities from what counts as behind it (update's "gone") to same_depth
+        nearer, agreeing in both views; None if there is none (a target moved farther waits
+        for the whole map)."""
         old = self.target
         bx, _, bw, _ = old.bbox
-        lo = old.disparity * (1 - self.cfg.same_depth)
-        hi = old.disparity * (1 + self.cfg.same_depth)
+        lo = old.disparity - max(1.0, 0.1 * old.disparity)  # farther: what lay behind it (a
+        hi = old.disparity * (1 + self.cfg.same_depth)  # wall seen through its columns)
         cols = np.full_like(disp, np.nan)
         band = disp[:, bx:bx + bw]
         cols[:, bx:bx + bw] = np.where((band >= lo) & (band <= hi), band, np.nan)
