@@ -80,3 +80,20 @@ def test_a_box_that_left_its_columns_is_not_found_there():
     holder[0] = disp
     tracker.update(disp, agreement)
     assert not tracker.confirmed and not tracker.retargeted
+
+
+def test_the_wall_seen_through_its_columns_is_not_the_target_moved_farther():
+    """A successor target at 14.1 px whose columns now show the wall 24 % farther (and, nearer,
+    a region whose views disagree): the in-place look must not take the wall for the target
+    moved (with same_depth's 35 % as its margin it did, and seed 17 #957 crept 20 s at the
+    wall's depth); the depth stays unconfirmed."""
+    disp = np.full((240, 320), 10.7, np.float32)  # the wall, also through its columns
+    disp[102:176, 240:261] = 32.2  # the nearer region, views disagreeing (x >= 100)
+    tracker = TargetTracker(Target(14.1, 9000, (206, 107, 87, 51), 0.1), 768)
+
+    def agreement(t: Target) -> float:  # the wall's views agree; the nearer region's do not
+        return 0.0 if t.disparity > 20 else 0.9
+    tracker.aged()
+    for _ in range(3):
+        tracker.update(disp, agreement)
+    assert not tracker.confirmed and tracker.target.disparity == 14.1
