@@ -114,8 +114,35 @@ class TargetTracker:
                 return self._succeed(vouched)
             return old
         if vouched is None:
+            here = None if overlap else self._in_place(disp, agreement)
+            if here is not None:  # something else is nearest (a flicker phantom, a nearer
+                return self.update_found(here)  # object not yet vouched for): the target
+                # measured in its own columns at its depth (seed 17 #699: 4 s of phantoms)
             return old  # hidden, a nearer object not yet vouched for, or nothing clear
         return self._retarget(vouched)
+
+    def _in_place(self, disp: np.ndarray, agreement: Callable[[Target], float]
+                  ) -> Target | None:
+        """The target where it was while something else is nearest (its map spoilt elsewhere
+        by flicker, a nearer object not yet vouched for): the nearest object in its columns
+        among the disparities from what counts as behind it (update's "gone") to same_depth
+        nearer, agreeing in both views; None if there is none (a target moved farther waits
+        for the whole map)."""
+        old = self.target
+        bx, _, bw, _ = old.bbox
+        lo = old.disparity - max(1.0, 0.1 * old.disparity)  # farther: what lay behind it (a
+        hi = old.disparity * (1 + self.cfg.same_depth)  # wall seen through its columns)
+        cols = np.full_like(disp, np.nan)
+        band = disp[:, bx:bx + bw]
+        cols[:, bx:bx + bw] = np.where((band >= lo) & (band <= hi), band, np.nan)
+        try:
+            here = nearest_object(cols, self.min_area, near=old.disparity)
+        except HostError:
+            return None
+        if not (lo <= here.disparity <= hi and agreement(here) >= self.cfg.still_there):
+            return None
+        # its depth only: the band of columns cuts its region, its extent stays as it was
+        return Target(here.disparity, old.area, old.bbox, here.spread)
 
     def update_found(self, found: Target) -> Target:
         """The target found again (moved or not): its disparity the median of the last
