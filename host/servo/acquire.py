@@ -232,7 +232,7 @@ class Acquisition:
         short of it with the estimate 6 cm beyond the truth)."""
         if self.phase != Phase.PROBE or self.facing_away is not None \
                 or self._paused_leg == self._leg or self._spin_why or self._after is not None \
-                or 3 * noise_m <= self.cfg.still_factor * self.cfg.probe_m:
+                or not self._far(noise_m):
             return False
         self._ledger_drive(t)
         self._paused_leg, self.paused_t = self._leg, t
@@ -550,7 +550,12 @@ class Acquisition:
         if len(self._track) < 10:
             return False  # no move measured (a marker seen in glimpses): as before
         z, d = self._track[-1][1], float(np.median(self._disp[-5:]))
-        return 3 * self._noise(z, d, noise_m) > self.cfg.still_factor * self.cfg.probe_m
+        return self._far(self._noise(z, d, noise_m))
+
+    def _far(self, noise_m: float) -> bool:
+        """Whether a sighting's depth noise noise_m (m) is a far one's: three of it beyond
+        still_factor times probe_m (a move under probe_m does not show there)."""
+        return 3 * noise_m > self.cfg.still_factor * self.cfg.probe_m
 
     def _back_duty(self) -> int:
         """The second leg's duty now: the first leg's duties in rising order, each until it

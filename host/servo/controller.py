@@ -434,14 +434,6 @@ class Controller:
         return max(cfg.half_width_m,
                    cfg.half_width_m * math.cos(a) + cfg.half_length_m * math.sin(a))
 
-    def gap_m(self, lateral: float) -> float | None:
-        """The body's clearance across from the object's extent (m, < 0: across it) at this
-        lateral position, with the body's reach (reach_m); None with no extent known."""
-        if self.keep_out is None:
-            return None
-        x0, x1 = self.keep_out
-        return max(lateral - x1, x0 - lateral) - self.reach_m()
-
     def update(self, obs: Observation) -> Command:
         self.turned_half = None
         if self.fault:

@@ -415,7 +415,7 @@ class Servo:
             fixed_target, fixed_floor = reference_target(fixed_disps, min_area)
             if bias_shrunk(bias, floor_column_bias(median_map(fixed_disps), fixed_floor)):
                 self.notes.append(bias.describe())
-                frames, disps, f = fixed, fixed_disps, fixed[-1]
+                disps, f = fixed_disps, fixed[-1]
                 target, self.floor = fixed_target, fixed_floor
             else:
                 self.column_bias = None

@@ -26,6 +26,7 @@ import numpy as np
 
 from host.errors import HostError
 from host.servo.perception import Floor, Target, nearest_object, span_overlap
+from host.servo.tracker import TrackerConfig
 from host.stereo.grey import to_grey
 
 
@@ -79,9 +80,10 @@ class RereferenceLimits:
     disparity_frac: float = 0.03
     overlap: float = 0.5
     agreement: float = 0.6
-    moved_frac: float = 0.35  # of the target's disparity: the farthest a target found at its
-    # place by two tries running (rereference_fault's earlier) may have moved in depth (the
-    # tracker's TrackerConfig.same_depth: farther, and it is another object)
+    # of the target's disparity: the farthest a target found at its place by two tries running
+    # (rereference_fault's earlier) may have moved in depth: the tracker's own bound (farther,
+    # and it is another object)
+    moved_frac: float = TrackerConfig.same_depth
     width_factor: float = 2.0  # a target moved in depth (target_moved) keeps its width scaled
     # by the disparities' ratio within this factor either way (a narrower object nearer, in
     # front of the box, does not scale so: a person's legs, a chair). Measured on the dev

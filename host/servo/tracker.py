@@ -27,6 +27,12 @@ from host.servo.perception import Target, fixed_cells, nearest_object, span_over
 VANISHED = "target vanished"
 
 
+def behind_px(d: float) -> float:
+    """The disparity (px) under which a reading lies behind a target at d: what its region
+    shows where the target has gone (a pixel, or a tenth of d, farther)."""
+    return d - max(1.0, 0.1 * d)
+
+
 @dataclass(frozen=True)
 class TrackerConfig:
     history: int = 3  # re-measures the target's disparity is the median of
@@ -98,7 +104,7 @@ class TargetTracker:
             return self.update_found(found)
         # gone means seen through: most of the object's area now shows what lies behind it; a
         # region hidden by something nearer (or masked as the robot) is not gone
-        behind = int(np.count_nonzero(there < old.disparity - max(1.0, 0.1 * old.disparity)))
+        behind = int(np.count_nonzero(there < behind_px(old.disparity)))
         if behind >= old.area // 2 and not agreement(old) >= self.cfg.still_there:
             moved = self._moved_back(disp, agreement)
             if moved is not None:  # the target moved farther, where it was: follow it,
@@ -130,7 +136,7 @@ class TargetTracker:
         for the whole map)."""
         old = self.target
         bx, _, bw, _ = old.bbox
-        lo = old.disparity - max(1.0, 0.1 * old.disparity)  # farther: what lay behind it (a
+        lo = behind_px(old.disparity)  # farther: what lay behind it (a
         hi = old.disparity * (1 + self.cfg.same_depth)  # wall seen through its columns)
         cols = np.full_like(disp, np.nan)
         band = disp[:, bx:bx + bw]

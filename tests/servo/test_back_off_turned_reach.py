@@ -79,9 +79,6 @@ def test_the_reach_across_follows_the_turn() -> None:
     for k in range(10):
         c.saw(1.5, 0.0, 0.5 if k == 3 else 1.0)
     assert c.reach_m() == pytest.approx(0.08)
-    assert c.gap_m(0.5) is None
-    c.keep_out = (0.2, 0.4)
-    assert c.gap_m(0.0) == pytest.approx(0.12)
 
 
 
