@@ -186,21 +186,34 @@ class TargetTracker:
     def _moved_back(self, disp: np.ndarray, agreement: Callable[[Target], float]
                     ) -> Target | None:
         """The target moved farther (toward a robot behind it, say) and still stands in its
-        columns: the nearest object within them, farther by less than same_depth and agreeing
-        in both views; None if there is none. Something nearer elsewhere (another robot beside
-        the lane) must not become the target's successor while the target is still there."""
+        columns: the nearest object within them among the disparities that count as behind it
+        (update's "gone") down to same_depth farther, agreeing in both views; None if there is
+        none. Something nearer elsewhere (another robot beside the lane) must not become the
+        target's successor while the target is still there, and a phantom nearer in its
+        columns hides nothing (seed 17 #555: flicker blobs at 21 px over a box gone from 19.2
+        to 16.2 px). Filling its columns edge to edge it is the wall seen through them, or the
+        target grown past its old columns (cut by the picture's edge, its inner edge moved
+        toward the centre: seed 17 #873): it is taken at its whole extent on the map, where
+        that overlaps its columns and is no wider than an object."""
         old = self.target
         bx, _, bw, _ = old.bbox
+        lo, hi = old.disparity * (1 - self.cfg.same_depth), behind_px(old.disparity)
+        band = np.where((disp >= lo) & (disp <= hi), disp, np.nan)
         cols = np.full_like(disp, np.nan)
-        cols[:, bx:bx + bw] = disp[:, bx:bx + bw]
+        cols[:, bx:bx + bw] = band[:, bx:bx + bw]
         try:
             here = nearest_object(cols, self.min_area, near=old.disparity)
+            x0, x1 = here.bbox[0], here.bbox[0] + here.bbox[2]
+            if not (x0 > bx or x1 < bx + bw):  # no edge of its own within its columns
+                here = nearest_object(band, self.min_area, near=here.disparity)
+                x0, x1 = here.bbox[0], here.bbox[0] + here.bbox[2]
+                if here.bbox[2] > self.cfg.object_width * disp.shape[1] \
+                        or span_overlap(bx, bx + bw, x0, x1) <= self.cfg.overlap:
+                    return None  # the wall behind, or another object elsewhere
         except HostError:
             return None
-        x0, x1 = here.bbox[0], here.bbox[0] + here.bbox[2]
-        if not (old.disparity * (1 - self.cfg.same_depth) <= here.disparity < old.disparity
-                and (x0 > bx or x1 < bx + bw)):  # an edge of its own: not the wall seen
-            return None  # through the columns, filling them edge to edge
+        if not lo <= here.disparity < old.disparity:
+            return None
         return here if agreement(here) >= self.cfg.still_there else None
 
     def _vouch(self, found: Target | None, agreement: Callable[[Target], float],
