@@ -203,6 +203,11 @@ class BackOffConfig:
     # for. Level with the face, closing, the other way runs the body past the object's end:
     # with a gap below this it stops (seed 15 trial 857: gap 1.0 cm reckoned, the heading
     # 2.5 degrees estimated, 23.5 true: the turned corner hit the side going deeper)
+    coast_s: float = 0.5  # after the flip the body coasts the first way this long at most
+    # (the wheels' latency, 60-120 ms, and run-down, 80 ms, at the back-off's ~8 cm/s): the
+    # second way's closing counts from where its own travel begins (seed 17 trial 193: 0.9 cm
+    # closed coasting 0.26 s after the flip stopped it "either way", while the second way
+    # opened the gap; tests/servo/test_back_off_closing.py)
 
 
 DONE = "done"
@@ -235,6 +240,8 @@ class BackOff:
         self.deeper: bool | None = None  # the way it backs off, fixed once measured
         self.start_z: float | None = None
         self.start_gap: float | None = None  # the body's gap to the object's side then
+        self.start_raw: float | None = None  # the centre's (half the width's) gap then
+        self.flip_t: float | None = None  # when it flipped to the other way
         self.flipped = False
         self.seen_t: float | None = None  # the card last seen
 
@@ -298,6 +305,7 @@ class BackOff:
         first = self.start_z is None
         if first:
             self.deeper, self.start_z, self.start_gap = e > cfg.beyond_m, z, gap
+            self.start_raw = raw
             if away and e > -cfg.level_m:
                 self.deeper = away > 0
         out = self.block_m + (0.0 if first else cfg.clear_m)
@@ -305,9 +313,16 @@ class BackOff:
             self.outcome = DONE  # out of the object's depth (measured again: never in it)
             return 0, 0
         assert self.start_z is not None
+        if self.flip_t is not None and t - self.flip_t <= cfg.coast_s and \
+                (z < self.start_z if self.deeper else z > self.start_z):
+            self.start_z, self.start_raw = z, raw  # still coasting the first way
         # closing on the side as it goes: turned toward it (a push alone closes far less
-        # per metre of depth travelled)
-        shrunk = 0.0 if gap is None or self.start_gap is None else self.start_gap - gap
+        # per metre of depth travelled). The centre's approach, not the turned body's gap:
+        # the card's turn bound (a median of ten aspects) moves by 0.5-1 cm from frame to
+        # frame with the body's turn unchanged (seed 17 trials 226 and 364: 0.07 cm of
+        # approach read as 0.6 cm of closing); a turn that grows is judged by the gap's
+        # own rules (at the side, behind the face) on every frame
+        shrunk = 0.0 if raw is None or self.start_raw is None else self.start_raw - raw
         least = cfg.turned_turn_m if turned_m >= cfg.turned_reach_m and not self.flipped \
             else cfg.turn_m  # the second way starts coasting the first: turn_m as ever
         closing = shrunk > max(least, cfg.turned * abs(z - self.start_z))
@@ -344,6 +359,7 @@ class BackOff:
         if closing and not tight:  # turned toward the object's side: the other way
             self.deeper, self.flipped, self.start_z, self.start_gap = \
                 not self.deeper, True, z, gap
+            self.start_raw, self.flip_t = raw, t
         sign = 1 if self.deeper == facing_away else -1
         d = sign * max(cfg.duty, floor)
         # straight while level with the face or behind it (beside): the steer's yaw swings the
