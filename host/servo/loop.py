@@ -613,7 +613,7 @@ class Servo:
         clean = without_floor(disp, self.floor)
         before = self.tracker.target
         target = self.tracker.update(clean, lambda t: views_agree(
-            frame.left, frame.right, t.bbox, t.disparity), frame.t_left)
+            frame.left, frame.right, t.bbox, t.disparity))
         if self.tracker.measured:
             self._measured_t = frame.t_left
             if not (self.tracker.retargeted or self._targets_before):

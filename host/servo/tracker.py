@@ -6,7 +6,7 @@ match). When most of its area twice shows what lay behind it and its two views n
 at its disparity (a map spoilt by flicker is not a box gone) the target is gone: the next
 nearest object becomes the target once two running re-measures find it at the same place and
 depth, its two views agreeing (the wall behind is no object); none within three more
-re-measures and 2 s, the run ends ("target vanished"; a pure state machine).
+re-measures, the run ends ("target vanished"; a pure state machine).
 A depth gone old (aged: no re-measure for longer than a box move may go unseen, e.g. over a
 turn) is confirmed afresh: by a reading agreeing with it, or, the target moved, by two
 readings agreeing with each other (their mean at once, not a median with the old value);
@@ -40,11 +40,7 @@ class TrackerConfig:
     overlap: float = 0.3  # of the narrower region's width: the same object
     still_there: float = 0.6  # views agreeing this well at the object's disparity: not gone
     successor: int = 2  # re-measures that must find the same next object once it is gone
-    successor_tries: int = 3  # re-measures after "gone" without one: the run ends,
-    vanish_s: float = 2.0  # and no sooner than this (s) after it was found gone: re-measures
-    # back to back (an aged depth, the robot waiting) run through the tries in 0.2 s, while a
-    # walker crossing near the camera (beyond the disparity range, its map garbage over the
-    # target) takes 1.3 s (seed 17 #228)
+    successor_tries: int = 3  # re-measures after "gone" without one: the run ends
     object_width: float = 0.6  # of the image's width: wider is the wall behind, no object
     same_depth: float = 0.35  # of its disparity: a target moved farther is another object
     fresh_agree: float = 0.01  # of its disparity: two readings this close agree (aged depth)
@@ -61,8 +57,6 @@ class TargetTracker:
         self.nearer = NearerObject()
         self.successor = NearerObject(frames=config.successor)  # the next object, once gone
         self.gone = 0  # re-measures since the target was found gone (0: it is not)
-        self._gone_t: float | None = None  # when it was found gone (None: no time given)
-        self._t: float | None = None  # the time of the update running
         self.measured = False  # the last update measured the target's depth
         self.fresh: list[float] | None = None  # readings since the depth aged (None: not
         # aged, the depth confirmed)
@@ -78,13 +72,11 @@ class TargetTracker:
         if self.fresh is None:
             self.fresh = []
 
-    def update(self, disp: np.ndarray, agreement: Callable[[Target], float] = lambda t: 1.0,
-               t: float | None = None) -> Target:
+    def update(self, disp: np.ndarray, agreement: Callable[[Target], float] = lambda t: 1.0
+               ) -> Target:
         """Measure again on disp (px, NaN = invalid: floor and robot left out): the target.
-        agreement: how well a region's two views match at its disparity (views_agree); t:
-        the frame's time (s; None: the run may end on the count of re-measures alone)."""
+        agreement: how well a region's two views match at its disparity (views_agree)."""
         self.retargeted = self.measured = False
-        self._t = t
         old = self.target
         bx, by, bw, bh = old.bbox
         there = disp[by:by + bh, bx:bx + bw]
@@ -124,7 +116,7 @@ class TargetTracker:
             # the next object is looked for from the first doubt on
             vouched = self._vouch(found if not overlap else None, agreement, disp.shape[1])
             if n >= self.cfg.agree:
-                self.gone, self._gone_t = 1, t
+                self.gone = 1
                 return self._succeed(vouched)
             return old
         if vouched is None:
@@ -237,9 +229,7 @@ class TargetTracker:
         becomes it; none after successor_tries more re-measures: the run ends (VANISHED)."""
         if vouched is None:
             self.gone += 1
-            waited = self._t is None or self._gone_t is None \
-                or self._t - self._gone_t >= self.cfg.vanish_s
-            if self.gone > self.cfg.successor_tries and waited:
+            if self.gone > self.cfg.successor_tries:
                 self.stop_reason = VANISHED
             return self.target
         self.gone = 0
