@@ -38,11 +38,13 @@ def _texture() -> tuple[np.ndarray, np.ndarray]:
                           [0, 0, 1]])
 
 
-def board_pairs(world: World, camera: CameraFaults, n: int = 24, seed: int = 0
-                ) -> list[StereoFrame]:
+def board_pairs(world: World, camera: CameraFaults, n: int = 24, seed: int = 0,
+                poses: list[tuple[np.ndarray, np.ndarray]] | None = None) -> list[StereoFrame]:
     """n pairs of a chessboard held at random poses 0.4-0.65 m in front of the camera, over the
     whole picture (corners and edges too, where distortion is largest), seen through the lenses
-    (the world's ideal geometry, then each side's radial distortion)."""
+    (the world's ideal geometry, each pixel the mean over its area, then each side's radial
+    distortion). poses: when given, each pair's board pose in the left camera (Rodrigues
+    vector, translation in mm; inner corner (0, 0) at the origin) is appended to it."""
     g, (w, h) = world.geometry, world.size
     k = np.array([[g.focal_px, 0, g.cx], [0, g.focal_px, g.cy], [0, 0, 1]])
     tex, a = _texture()
@@ -59,6 +61,8 @@ def board_pairs(world: World, camera: CameraFaults, n: int = 24, seed: int = 0
         z = rng.uniform(400, 650)
         centre = np.array([rng.uniform(-0.2, 0.2) * z, rng.uniform(-0.12, 0.12) * z, z])
         t = centre - r @ mid
+        if poses is not None:
+            poses.append((rvec, t))
         views = []
         for side, lens in enumerate(lenses):
             shift = np.array([-world.geometry.baseline_m * 1000 * side, 0, 0])
@@ -89,3 +93,25 @@ def calibrate_camera(world: World, camera: CameraFaults, seed: int = 0,
         if len(found) >= pairs:
             break
     return calibrate(found[:pairs], BOARD, SQUARE_MM).calibration
+
+
+def rectified_disparity_error(world: World, calib: Calibration, lenses: tuple[float, float],
+                              x: np.ndarray, y: np.ndarray, z: np.ndarray
+                              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """How far a calibration of the simulated camera leaves rectified disparity from the truth:
+    world points (x right, y above the floor, z deep; m) through the true lenses (lens_maps'
+    model), then the calibration's undistortion and rectification. Returns the disparity's
+    excess over the calibrated geometry's f'B'/z (px), the depth it gives less z (m), and the
+    points' rectified left columns (px)."""
+    g, m = world.geometry, calib.mats
+    k = np.array([[g.focal_px, 0, g.cx], [0, g.focal_px, g.cy], [0, 0, 1]])
+    rect = []
+    for side in (0, 1):
+        rays = np.column_stack([x - g.baseline_m * side, world.height_m - y, z])
+        raw, _ = cv2.projectPoints(rays.astype(np.float64), np.zeros(3), np.zeros(3), k,
+                                   np.array([lenses[side], 0, 0, 0, 0], np.float64))
+        kk, d, r, p = (m[f"{name}{side + 1}"] for name in ("M", "D", "R", "P"))
+        rect.append(cv2.undistortPoints(raw, kk, d, R=r, P=p).reshape(-1, 2))
+    disp = rect[0][:, 0] - rect[1][:, 0]
+    fb = calib.geometry.focal_px * calib.geometry.baseline_m
+    return disp - fb / z, fb / disp - z, rect[0][:, 0]
