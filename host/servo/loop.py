@@ -792,30 +792,33 @@ class Servo:
         true push the other way or half of it): the robot stands (the controller's drive,
         creep or search spin not sent) until the card shows the rate standing, and the same
         check then decides on that rate (unseen_horizon_s, the card seen or not: the stop it
-        would have been, deferred; a rate not yet shown decides nothing). Every frame of the
-        stand it ends the run as before once the rate it has would bring the body, moved on
-        at that rate, within block_margin_m of the object within push_horizon_s (the lead the
-        seen hold's check gives a push it has fitted: a true push at that rate ends the run
-        before it could touch); a command that cannot wait (a turn round, the acquisition's
-        moves, a back-off), or the stand unseen_horizon_s - push_horizon_s long (the longest
-        that check lets a rate toward the object stand), is decided on the rate it has, as
-        before. fault: this frame's check of the command. The command to send, why it stands,
-        and the fault."""
+        would have been, deferred; a rate not yet shown releases nothing). The run ends as
+        before, the rate not yet shown standing: every frame of the stand, once the rate it
+        has would bring the body, moved on at that rate, within block_margin_m of the object
+        within push_horizon_s (the lead the seen hold's check gives a push it has fitted: a
+        true push at that rate ends the run before it could touch); for a command that cannot
+        wait (a turn round, the acquisition's moves, a back-off) or the estimate dropped; after
+        unseen_horizon_s - push_horizon_s of standing (the longest that check lets a rate
+        toward the object stand). Seen away from the object's depth, the check is not on and
+        the stand ends. fault: this frame's check of the command. The command to send, why it
+        stands, and the fault."""
         est, c = self.estimator, self.controller
         s = est.state
-        if s is None or c is None or abs(s.z - c.target_m) >= c.cfg.block_m:
-            self._drift_since = None
+        if c is None or s is not None and abs(s.z - c.target_m) >= c.cfg.block_m:
+            self._drift_since = None  # seen away from the object's depth: the check is not on
             return cmd, "", fault
+        if s is None:  # the estimate dropped (a re-acquisition) before the rate was shown
+            self._drift_since = None
+            return cmd, "", fault or DRIFTED
         x = s.x + s.vx * max(0.0, t - s.t)
-        closes = c.closing(x, s.vx, seen=False)
+        if est.rate_stood:  # the rate shown standing decides, as the check does
+            self._drift_since = None
+            return cmd, "", (fault or DRIFTED) if c.closing(x, s.vx, seen=False) else fault
         waits = cmd.is_stop or (self.acquisition.done and self.backoff is None and
                                 cmd.phase in (Phase.DRIVE, Phase.CREEP, Phase.SEARCH))
         spent = self._drift_since is not None and \
             t - self._drift_since >= c.cfg.unseen_horizon_s - c.cfg.push_horizon_s
-        if est.rate_stood or not waits or spent:  # decided on the rate it has, as before
-            self._drift_since = None
-            return cmd, "", (fault or DRIFTED) if closes else fault
-        if c.closing(x, s.vx, seen=True):
+        if not waits or spent or c.closing(x, s.vx, seen=True):  # the stop, as it was
             self._drift_since = None
             return cmd, "", fault or DRIFTED
         if self._drift_since is None:

@@ -181,13 +181,11 @@ def test_the_rate_shown_standing_decides_as_the_check_did(scene: Servo, vx: floa
         assert servo._drift_since is None
 
 
-def test_a_rate_not_yet_shown_standing_decides_nothing_until_the_stands_bound(
-        scene: Servo) -> None:
+def test_a_rate_not_yet_shown_standing_releases_nothing(scene: Servo) -> None:
     """In the stand, the card back for a few sightings that turn the rate away from the
     object (not yet stood_sightings): the robot stands on (a rate half learnt releases
-    nothing); at unseen_horizon_s - push_horizon_s of standing the check decides on the rate
-    it has, as before: it no longer closes, the stand ends and the controller's command goes
-    out."""
+    nothing, a command that cannot wait does not either); at unseen_horizon_s -
+    push_horizon_s of standing with no rate shown standing the run ends as before."""
     servo = _beside(scene, driven=True)
     c = servo.controller
     assert c is not None
@@ -200,7 +198,17 @@ def test_a_rate_not_yet_shown_standing_decides_nothing_until_the_stands_bound(
     sent, why = _frame(servo, bound - 0.05, hold)
     assert why.startswith(f"standing: {DRIFTED}") and not servo.stop_reason, why
     sent, why = _frame(servo, bound, hold)
-    assert sent == hold and not why and not servo.stop_reason and servo._drift_since is None
+    assert servo.stop_reason == DRIFTED and sent.phase == Phase.STOP
+
+
+def test_a_turn_round_in_the_stand_ends_the_run_on_a_rate_not_yet_shown(scene: Servo) -> None:
+    """The card back (the rate half learnt, away from the object) and the controller starts a
+    turn round, which cannot wait: the run ends as the check first said."""
+    servo = _beside(scene, driven=True)
+    _frame(servo, T0 + 0.2, Command(0, 0, Phase.LOST, None))
+    servo.estimator.state = _State(T0 + 0.6, Z, X + VX * 0.4, 0.0, 0.002)
+    sent, _ = _frame(servo, T0 + 0.6, Command(400, -400, Phase.TURN, None))
+    assert servo.stop_reason == DRIFTED and sent.phase == Phase.STOP
 
 
 def test_a_robot_pushed_onto_the_object_at_the_rate_it_drove_with_stops_in_time() -> None:
