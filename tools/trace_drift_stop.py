@@ -1,4 +1,6 @@
-"""Trace a trial's DRIFTED stop: estimate vs world truth when it fires; --run-on suppresses it."""
+"""Trace a trial's DRIFTED stop: estimate vs world truth when it fires; --run-on suppresses it.
+The stands on a rate learnt driven (Servo._drift_stand) are counted, with the true gap at each
+stand's start and end."""
 
 import math
 import sys
@@ -15,8 +17,9 @@ seed = int(sys.argv[sys.argv.index("--seed") + 1])
 runon = "--run-on" in sys.argv
 args = build_parser().parse_args(["servo", "--sim", "--trials", "1", "--seed", "13"])
 params = params_from_args(args)
-st = {"w": None, "first": None, "lastseen": None, "mingap": 9.0, "n": 0}
+st = {"w": None, "first": None, "lastseen": None, "mingap": 9.0, "n": 0, "stands": []}
 orig = L.Servo._spin_fault
+orig_stand = L.Servo._drift_stand
 
 
 def truth_gap(w):
@@ -72,7 +75,22 @@ def sf(self, t, cmd):
     return why
 
 
+def ds(self, t, cmd, fault):
+    out = orig_stand(self, t, cmd, fault)
+    w = st["w"]
+    g = truth_gap(w)[0] if w is not None else math.nan
+    stands = st["stands"]
+    if out[1]:
+        if not stands or stands[-1][-1] is not None:
+            s = self.estimator.state
+            stands.append([t, g, s.vx, w.motor_faults.push_mps, None])
+    elif stands and stands[-1][-1] is None:
+        stands[-1][-1] = (t, g, out[2])
+    return out
+
+
 L.Servo._spin_fault = sf
+L.Servo._drift_stand = ds
 orig_sim = T.simulation
 
 
@@ -85,6 +103,10 @@ def sim2(*a, **k):
 
 T.simulation = sim2
 tr = T.run_trial((seed, idx, parse_size(args.size), params, False))
+for t0, g0, vx, push, end in st["stands"]:
+    print(f"STAND from {t0:.2f} s (true gap {g0:+.4f}, rate {vx * 100:+.2f} cm/s learnt driven,"
+          f" true push {push * 100:+.2f} cm/s): " + ("still standing at the end" if end is None else
+          f"ended at {end[0]:.2f} s ({end[2] or 'released'}), true gap {end[1]:+.4f}"))
 print(
     "OUTCOME",
     tr.outcome,

@@ -302,6 +302,7 @@ class Servo:
         self._measured_t: float | None = None  # the target's depth last measured (frame time)
         self._stand_since: float | None = None  # standing for a re-measure since
         self._spin_stand_since: float | None = None  # a spin held for a re-measure since
+        self._drift_since: float | None = None  # standing on a rate learnt driven since
         self._cmd = Command(0, 0, Phase.WAIT, None)  # the command in force
         self._statics: list[tuple[float, float, float]] = []  # where non-moving look-alikes
         # stand: (u, v) px in the left image, depth (m)
@@ -782,6 +783,51 @@ class Servo:
         if t - s.t > 0.1 and c.closing(s.x + s.vx * (t - s.t), s.vx, seen=False):
             return DRIFTED
         return ""
+
+    def _drift_stand(self, t: float, cmd: Command, fault: str) -> tuple[Command, str, str]:
+        """The card unseen, the sideways rate the robot last had brings the body onto the
+        object within unseen_horizon_s (_spin_fault's DRIFTED), but that rate was learnt
+        while the robot was driven (Estimator.rate_stood: a drive's curve, a spin's swinging
+        card, run on over the stop; seed 17: 5 of its 7 false "drifting unseen" stops, the
+        true push the other way or half of it): the robot stands (the controller's drive,
+        creep or search spin not sent) until the card shows the rate standing, and the same
+        check then decides on that rate (unseen_horizon_s, the card seen or not: the stop it
+        would have been, deferred; a rate not yet shown releases nothing). The run ends as
+        before, the rate not yet shown standing: every frame of the stand, once the rate it
+        has would bring the body, moved on at that rate, within block_margin_m of the object
+        within push_horizon_s (the lead the seen hold's check gives a push it has fitted: a
+        true push at that rate ends the run before it could touch); for a command that cannot
+        wait (a turn round, the acquisition's moves, a back-off) or the estimate dropped; after
+        unseen_horizon_s - push_horizon_s of standing (the longest that check lets a rate
+        toward the object stand). Seen away from the object's depth, the check is not on and
+        the stand ends. fault: this frame's check of the command. The command to send, why it
+        stands, and the fault."""
+        est, c = self.estimator, self.controller
+        s = est.state
+        if c is None or s is not None and abs(s.z - c.target_m) >= c.cfg.block_m:
+            self._drift_since = None  # seen away from the object's depth: the check is not on
+            return cmd, "", fault
+        if s is None:  # the estimate dropped (a re-acquisition) before the rate was shown
+            self._drift_since = None
+            return cmd, "", fault or DRIFTED
+        x = s.x + s.vx * max(0.0, t - s.t)
+        if est.rate_stood:  # the rate shown standing decides, as the check does
+            self._drift_since = None
+            return cmd, "", (fault or DRIFTED) if c.closing(x, s.vx, seen=False) else fault
+        waits = cmd.is_stop or (self.acquisition.done and self.backoff is None and
+                                cmd.phase in (Phase.DRIVE, Phase.CREEP, Phase.SEARCH))
+        spent = self._drift_since is not None and \
+            t - self._drift_since >= c.cfg.unseen_horizon_s - c.cfg.push_horizon_s
+        if not waits or spent or c.closing(x, s.vx, seen=True):  # the stop, as it was
+            self._drift_since = None
+            return cmd, "", fault or DRIFTED
+        if self._drift_since is None:
+            self._drift_since = t
+        if not cmd.is_stop:
+            c.phase = Phase.WAIT
+            cmd = Command(0, 0, Phase.WAIT, cmd.error_m)
+        return cmd, (f"standing: {DRIFTED} on a rate learnt driven ({s.vx * 100:+.1f} cm/s): "
+                     "waiting for the card to show it standing"), ""
 
     def _fixed_fault(self, t: float, cmd: Command) -> str:
         """Whether the command would take the robot's body into a fixed object of the
@@ -1461,6 +1507,10 @@ class Servo:
         fault = self._path_fault(frame, cmd) if moving else self._spin_fault(frame.t_left, cmd)
         if moving and cmd.left * cmd.right < 0:  # the probe's spin test: a spin, checked as
             fault = fault or self._spin_fault(frame.t_left, cmd)  # one (sweeps, aged depth)
+        if fault == DRIFTED or not fault and self._drift_since is not None:
+            # on a rate learnt driven, it stands for the card to show the rate standing
+            cmd, stand, fault = self._drift_stand(frame.t_left, cmd, fault)
+            moving, invalid = moving and not cmd.is_stop, invalid or stand
         if self.acquisition.paused_t is not None:
             stand, fault = self._probe_paused(frame, t, cmd, fault)
             if stand:
