@@ -13,6 +13,12 @@ once, so the sums it reads are still in L1. Sums are uint16 when the largest win
 The columns left of the full range (x < nd + half, where some candidates' right windows leave
 the image) slide and take their minimum in the same vector pass as the interior, the candidates
 outside masked, instead of one plain loop per candidate.
+
+Two kernels, the same maps bit for bit: uint16 column and window sums (grey and colour up to
+window 9, the bench's and the servo's) take _match_u16, written in explicit 16-lane vectors
+(sad_lanes.py: the column sums one channel at a time with the candidate loop innermost; the
+window's slide, its minimum and the first lane equal to it; the right map's costs), at 0.4-0.6x
+the time of _match_any, the loops LLVM vectorises, which every other lane type takes.
 """
 
 from __future__ import annotations
