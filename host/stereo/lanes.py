@@ -9,8 +9,7 @@ machines run it at the same rate, and SSE2 machines as two halves).
 load(a, i) / store(a, i, v): lanes a[i .. i + 16] of a C-contiguous uint16 array (no bounds
 check: the caller keeps i + 16 <= a.size). splat(x): x in every lane. vmin, vadd, vsub: per
 lane, wrapping like uint16. hmin(v): the smallest lane. select_ge(k, a, b): lane j takes a's
-lane where j >= k, else b's. down1(a, b): a's lanes 1 .. 15 then b's lane 0 (the 32 lanes of a
-and b moved down one lane).
+lane where j >= k, else b's.
 """
 
 from __future__ import annotations
@@ -143,14 +142,3 @@ def select_ge(typingctx, k, a, b):
         take = builder.icmp_unsigned(">=", _iota(builder), kv)
         return builder.select(take, args[1], args[2])
     return u16x16(k, a, b), codegen
-
-
-@intrinsic
-def down1(typingctx, a, b):
-    if not (a == u16x16 and b == u16x16):
-        return None
-
-    def codegen(context, builder, sig, args):
-        mask = ir.Constant(ir.VectorType(ir.IntType(32), LANES), list(range(1, LANES + 1)))
-        return builder.shuffle_vector(args[0], args[1], mask)
-    return u16x16(a, b), codegen

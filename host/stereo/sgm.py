@@ -386,11 +386,10 @@ def _start(dst, c, nd):
 
 
 @njit(cache=True, fastmath=True, inline="always")
-def _sum_into(o, s, a1, a2, a3, a4, nd, with_min, inplace):
-    """o[j] = s[j] + a1[j+1] + a2[j+1] + a3[j+1] + a4[j+1]; returns min o when with_min, else
-    0. A path left out is passed as a row of zeros (nd + 2). inplace: s is o itself, so the
-    overlapping last vector (nd not a multiple of 16) keeps the lanes already summed; else it
-    writes the same sums again and needs no select."""
+def _sum_into(o, s, a1, a2, a3, a4, nd, with_min):
+    """o[j] = s[j] + a1[j+1] + a2[j+1] + a3[j+1] + a4[j+1] (s may be o itself: the overlapping
+    last vector keeps the lanes already summed); returns min o when with_min, else 0. A path
+    left out is passed as a row of zeros (nd + 2)."""
     if nd < L.LANES:
         lo = np.uint16(0xFFFF)
         for j in range(nd):
@@ -405,38 +404,11 @@ def _sum_into(o, s, a1, a2, a3, a4, nd, with_min, inplace):
         old = L.load(s, b)
         v = L.vadd(L.vadd(old, L.load(a1, b + 1)), L.vadd(L.load(a2, b + 1), L.vadd(
             L.load(a3, b + 1), L.load(a4, b + 1))))
-        if inplace and j > b:
-            v = L.select_ge(j - b, v, L.load(o, b))
+        v = L.select_ge(j - b, v, L.load(o, b))
         L.store(o, b, v)
         lo = L.vmin(lo, v)
         j += L.LANES
     return L.hmin(lo) if with_min else np.uint16(0)
-
-
-@njit(cache=True, fastmath=True, inline="always")
-def _add_rows(o, a1, a2, a3, a4, k, nd):
-    """o[j] = a1[j+1] + a2[j+1], plus a3[j+1] where k >= 3 and a4[j+1] where k >= 4 (k: a
-    constant at each call, so the rows left out are neither loaded nor added: _sum_into with
-    rows of zeros loaded and added them, and a select per vector)."""
-    if nd < L.LANES:
-        for j in range(nd):
-            v = np.uint16(a1[j + 1] + a2[j + 1])
-            if k >= 3:
-                v = np.uint16(v + a3[j + 1])
-            if k >= 4:
-                v = np.uint16(v + a4[j + 1])
-            o[j] = v
-        return
-    j = 0
-    while j < nd:
-        b = min(j, nd - L.LANES)
-        v = L.vadd(L.load(a1, b + 1), L.load(a2, b + 1))
-        if k >= 3:
-            v = L.vadd(v, L.load(a3, b + 1))
-        if k >= 4:
-            v = L.vadd(v, L.load(a4, b + 1))
-        L.store(o, b, v)
-        j += L.LANES
 
 
 @njit(cache=True, fastmath=True, inline="always")
@@ -623,13 +595,13 @@ def _sweep(cl, crrev, gl, gr, vol, pl, prrev, term, S, C, P, M, crow, tot, forwa
                     M[b, 3, x] = _step(P[a, 3, x + step], M[a, 3, x + step], d3, c, p1,
                                        _pen(T, G, y, x, y - step, x + step), nd)
                 if finish:
-                    mins[x] = _sum_into(tot[x], S[y, x], h0, d1, v2, d3, nd, True, False)
+                    mins[x] = _sum_into(tot[x], S[y, x], h0, d1, v2, d3, nd, True)
                 else:
-                    _add_rows(S[y, x], h0, d1, v2, d3, 4, nd)
+                    _sum_into(S[y, x], Z, h0, d1, v2, d3, nd, False)
             elif finish:
-                mins[x] = _sum_into(tot[x], S[y, x], h0, v2, Z, Z, nd, True, False)
+                mins[x] = _sum_into(tot[x], S[y, x], h0, v2, Z, Z, nd, True)
             else:
-                _add_rows(S[y, x], h0, v2, Z, Z, 2, nd)
+                _sum_into(S[y, x], Z, h0, v2, Z, Z, nd, False)
         if finish:
             _decide_row(tot, mins, y, dmin, uniqueness, fit, want_right, disp_l, disp_r, acc,
                         acc16, sh, idx, jj, fb, rr, lr)
@@ -667,7 +639,7 @@ def _from_the_right(crow, H, tot, mins, Z, p1, T, G, y, nd):
         h4 = H[t % 2]
         m4 = _start(h4, c, nd) if t == 0 else _step(H[1 - t % 2], m4, h4, c, p1,
                                                      _pen(T, G, y, x, y, x + 1), nd)
-        mins[x] = _sum_into(tot[x], tot[x], h4, Z, Z, Z, nd, True, True)
+        mins[x] = _sum_into(tot[x], tot[x], h4, Z, Z, Z, nd, True)
 
 
 @njit(cache=True, fastmath=True, inline="always")
@@ -699,8 +671,6 @@ def _from_the_right_decided(crow, H, tot, fb, acc16, sh, sat, idx, p1, T, G, y, 
     big = L.splat(np.uint16(0xFFFF))
     two = L.splat(np.uint16(2))
     acc16[:] = np.uint16(0xFFFF)
-    whole = nd % L.LANES == 0
-    win = np.full(nd if whole else 0, 0xFFFF, dtype=np.uint16)
     for t in range(w):
         x = w - 1 - t
         c = crow[x]
@@ -709,35 +679,12 @@ def _from_the_right_decided(crow, H, tot, fb, acc16, sh, sat, idx, p1, T, G, y, 
                                                      _pen(T, G, y, x, y, x + 1), nd)
         o = tot[x]
         lo = big
-        if whole:
-            # the right view's entries w - x .. w - x + nd - 1 in the window win, lane j at
-            # win[j], updated in lanes and moved down one lane a pixel (down1): its loads and
-            # stores stay at the same places from pixel to pixel, so each load takes the
-            # value the last pixel stored from the store queue; entry w - x, final, goes to
-            # acc16[w - x] (the vector's other lanes are written over by later pixels)
-            prev = big
-            for b in range(0, nd, L.LANES):
-                v = L.vadd(L.load(o, b), L.load(h4, b + 1))
-                L.store(o, b, v)
-                if sat:
-                    v = L.vmin(v, topv)
-                pk = _vor(_vshl(v, shv), L.load(idx, b))
-                lo = L.vmin(lo, pk)
-                u = L.vmin(L.load(win, b), pk)
-                if b == 0:
-                    L.store(acc16, w - x, u)
-                else:
-                    L.store(win, b - L.LANES, L.down1(prev, u))
-                prev = u
-            L.store(win, nd - L.LANES, L.down1(prev, big))
         j = 0
-        while j < nd and not whole:
+        while j < nd:
             b = min(j, nd - L.LANES)
             old = L.load(o, b)
             # the overlapping last vector keeps the lanes already summed (as _sum_into)
-            v = L.vadd(old, L.load(h4, b + 1))
-            if j > b:
-                v = L.select_ge(j - b, v, old)
+            v = L.select_ge(j - b, L.vadd(old, L.load(h4, b + 1)), old)
             L.store(o, b, v)
             if sat:
                 v = L.vmin(v, topv)
@@ -875,7 +822,7 @@ def _down(cl, crrev, gl, gr, vol, pl, prrev, term, S, P, M, crow, tot, y0, y1, w
             h0 = H[x % 2]
             m0 = _start(h0, c, nd) if x == 0 else _step(H[1 - x % 2], m0, h0, c, p1,
                                                          _pen(T, G, y, x, y, x - 1), nd)
-            _add_rows(tot[x], h0, d1, v2, d3, 4, nd)
+            _sum_into(tot[x], Z, h0, d1, v2, d3, nd, False)
         if not decided:
             continue
         if fsh:
@@ -1019,7 +966,7 @@ def _four(cl, crrev, gl, gr, vol, pl, prrev, term, S, y0, y1, K, ck, ckm, top, t
                 h0 = H[x % 2]
                 m0 = _start(h0, c, nd) if x == 0 else _step(H[1 - x % 2], m0, h0, c, p1,
                                                             _pen(T, G, y, x, y, x - 1), nd)
-                _add_rows(tot[x], h0, v, BB[r, x], Z, 3, nd)
+                _sum_into(tot[x], Z, h0, v, BB[r, x], Z, nd, False)
             if fsh:
                 _from_the_right_decided(crow, H, tot, fb, acc16, fsh, sh == 0, idx, p1, T,
                                         G, y, nd, uniqueness)
