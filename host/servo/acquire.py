@@ -22,7 +22,8 @@ way the robot faces by what a short probe move does (a pure state machine, one c
              else the run stops (UNSHOWN), never on the sign of a move within the noise
              (seed 12's trial 246 at 3 m); the marker unseen for
              probe_gap_s (the robot stands): the probe's clock stops meanwhile, but for the
-             gap's first run_down_s (the last drive's reaction and run-down);
+             gap's first run_down_s (the last drive's reaction and run-down); unseen for
+             probe_unseen_s, the run stops (PROBE_UNSEEN);
              a probe started again (after a stale frame, a knock) runs within what is left
              of probe_s: probe_s bounds its clock, and so its travel, in all until a
              sighting is proven; used up, it decides as at probe_s on the sightings since
@@ -69,6 +70,7 @@ BLIND = ("the probe's second leg, back at its start, did not show the sighting g
          "that may be a look-alike's")
 PROBED_OUT = ("the probe move, started again, ran its {:.1f} s in all without a sighting "
               "proven to be the robot's")
+PROBE_UNSEEN = "the marker was not seen for {:.1f} s standing in the probe"
 
 
 @dataclass(frozen=True)
@@ -84,6 +86,8 @@ class AcquireConfig:
     probe_m: float = 0.02
     probe_s: float = 1.5  # a robot that can move has moved by then
     probe_gap_s: float = 0.3  # the marker unseen this long in the probe: its clock stops
+    probe_unseen_s: float = 5.0  # and this long (standing): the run stops (PROBE_UNSEEN), named
+    # (dev seed 105's trial 24 stood unseen from 38 s to the 45 s limit: "did not settle")
     run_down_s: float = REACT_S  # of such a gap still counted: the last drive's reaction and
     # the wheels' run-down moved the robot on (the servo's react_s)
     floor_px: float = 0.1  # a sighting's disparity noise at least (px): far sightings err
@@ -403,9 +407,12 @@ class Acquisition:
         if self._after is not None:
             return self._standing_after(t, position, noise_m)
         self._ledger_drive(t)
-        if position is None or disparity is None:
-            return Order(0, 0, Phase.PROBE)  # not seen: stand until it is
-        gap = t - (self._track[-1][0] if self._track else self._t0)
+        seen = self._track[-1][0] if self._track else self._t0
+        if position is None or disparity is None:  # not seen: stand until it is, within
+            if t - seen > cfg.probe_unseen_s:  # probe_unseen_s
+                self.fault = PROBE_UNSEEN.format(t - seen)
+            return Order(0, 0, Phase.PROBE)
+        gap = t - seen
         if gap > cfg.probe_gap_s:
             # unseen meanwhile (hidden by something passing), standing: the probe's clock
             # stops for the gap; timed on, it would find that the marker "did not move" and
