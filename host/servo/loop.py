@@ -736,8 +736,8 @@ class Servo:
         aged check ends it as before (seed 14: 12 such stops, the robot 0.3-1.8 m behind the
         object's believed depth). Why it stands, or "" (the checks go on as they were)."""
         est, c, tr = self.estimator, self.controller, self.tracker
-        spin = not cmd.is_stop and cmd.phase == Phase.SEARCH  # (the acquisition's FIND spin
-        # has timers of its own: left as it was)
+        spin = not cmd.is_stop and cmd.phase in (Phase.SEARCH, Phase.FIND)  # (FIND's clock
+        # runs on while it stands: seed 17 #524 #612, 0.24-1 m off the face's depth, issue 23)
         s = est.state
         if not spin or s is None or c is None or tr is None or self._measured_t is None:
             self._spin_stand_since = None
@@ -752,7 +752,8 @@ class Servo:
         if t - self._spin_stand_since > self.cfg.remeasure_stand_s:
             return ""  # not measured again standing: the aged check ends the run
         tr.aged()
-        c.phase = Phase.WAIT
+        if cmd.phase == Phase.SEARCH:
+            c.phase = Phase.WAIT
         return f"re-measuring the target before the spin: its depth is {age:.1f} s old"
 
     def _spin_fault(self, t: float, cmd: Command) -> str:
