@@ -80,6 +80,7 @@ def _dark_opened(grey: np.ndarray, local: np.ndarray) -> np.ndarray:
 
 RECENTRE = 4  # the centroid taken again round itself at most this often (find_discs)
 RECENTRE_PX = 0.005  # until it moves less than this
+RECENTRE_REACH = 0.15  # radii: a centre re-centred farther than this from the first is not taken
 
 
 def _centroid(grey: np.ndarray, cx: float, cy: float, r: float, recentre: int = 0
@@ -241,11 +242,18 @@ def find_discs(image: np.ndarray, min_radius: float = 2.5, max_radius: float = 8
     for i, x, y, w, h in _screen(points, sizes, min_area, math.pi * max_radius ** 2):
         c = outlines[i]
         r = (w + h) / 4
-        u, v = _centroid(grey, x + (w - 1) / 2, y + (h - 1) / 2, r, recentre)
+        u, v = _centroid(grey, x + (w - 1) / 2, y + (h - 1) / 2, r)
         # printed: a uniform light ring round a uniform dark disc (texture is neither)
         ring, disc, ring_sd, disc_sd = _ring_and_disc(grey, u, v, r)
         if ring - disc < 80 or max(ring_sd, disc_sd) > 0.2 * (ring - disc):
             continue
+        if recentre:  # the blobs kept as before; a kept disc's centre re-centred (issue 23):
+            # re-centred before the ring's test, a blob of texture took a place that passed it
+            # (dev 105 #6: a false marker 100 px above the true one). A whole disc's centre
+            # moves a few tenths of a pixel; more is no clean disc, whose first one stands
+            u2, v2 = _centroid(grey, u, v, r, recentre - 1)
+            if math.hypot(u2 - u, v2 - v) <= RECENTRE_REACH * r:
+                u, v = u2, v2
         m = cv2.moments(c)
         aspect = math.sqrt(m["mu20"] / m["mu02"]) if m["mu02"] > 0 else 1.0
         blobs.append(Blob(u, v, r, aspect))
