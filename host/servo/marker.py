@@ -78,9 +78,28 @@ def _dark_opened(grey: np.ndarray, local: np.ndarray) -> np.ndarray:
     return out
 
 
-def _centroid(grey: np.ndarray, cx: float, cy: float, r: float) -> tuple[float, float]:
-    """Darkness-weighted centroid within 1.3 r (the disc plus a band of ring), sub-pixel."""
+RECENTRE = 4  # the centroid taken again round itself at most this often (find_discs)
+RECENTRE_PX = 0.005  # until it moves less than this
+RECENTRE_REACH = 0.15  # radii: a centre re-centred farther than this from the first is not taken
+
+
+def _centroid(grey: np.ndarray, cx: float, cy: float, r: float, recentre: int = 0
+              ) -> tuple[float, float]:
+    """Darkness-weighted centroid within 1.3 r (the disc plus a band of ring), sub-pixel;
+    then, recentre times at most, the same round the centroid found. The first circle is
+    round the mask's bounding box, whose centre is off the disc's by up to a pixel (the dark
+    threshold is against the neighbourhood's mean, which the background behind the card
+    moves), so the circle cuts the disc's anti-aliased edge on one side and takes more of the
+    ring's shading on the other: the centroid is pulled toward the box's centre, differently
+    in each view (at 3 m, r ~4 px: up to 0.3 px of disparity, ~10 cm of depth; issue 23).
+    Round the centroid itself the circle holds the whole disc symmetrically."""
     u, v = _centroid_of(grey, cx, cy, r, (1.3 * r) ** 2)
+    for _ in range(recentre):
+        u2, v2 = _centroid_of(grey, u, v, r, (1.3 * r) ** 2)
+        moved = max(abs(u2 - u), abs(v2 - v))
+        u, v = u2, v2
+        if moved < RECENTRE_PX:
+            break
     return float(u), float(v)
 
 
@@ -202,9 +221,11 @@ def _numpy_sum(a: np.ndarray) -> float:
 
 
 def find_discs(image: np.ndarray, min_radius: float = 2.5, max_radius: float = 80.0,
-               window: int = 31) -> list[Blob]:
+               window: int = 31, recentre: int = RECENTRE) -> list[Blob]:
     """Dark, round blobs inside a lighter ring; window (px, odd) is the neighbourhood the disc
-    is darker than, and must be wider than the disc (find_marker sizes it)."""
+    is darker than, and must be wider than the disc (find_marker sizes it); recentre: how
+    often at most the centroid is taken again round itself (_centroid; 0: once, round the
+    mask's box, as before issue 23's mend)."""
     grey = to_grey(image)
     # dark relative to the neighbourhood: the ring makes the disc stand out locally (grey <
     # local - 40; where local < 40 the saturated difference is 0 and nothing is below it)
@@ -226,6 +247,13 @@ def find_discs(image: np.ndarray, min_radius: float = 2.5, max_radius: float = 8
         ring, disc, ring_sd, disc_sd = _ring_and_disc(grey, u, v, r)
         if ring - disc < 80 or max(ring_sd, disc_sd) > 0.2 * (ring - disc):
             continue
+        if recentre:  # the blobs kept as before; a kept disc's centre re-centred (issue 23):
+            # re-centred before the ring's test, a blob of texture took a place that passed it
+            # (dev 105 #6: a false marker 100 px above the true one). A whole disc's centre
+            # moves a few tenths of a pixel; more is no clean disc, whose first one stands
+            u2, v2 = _centroid(grey, u, v, r, recentre - 1)
+            if math.hypot(u2 - u, v2 - v) <= RECENTRE_REACH * r:
+                u, v = u2, v2
         m = cv2.moments(c)
         aspect = math.sqrt(m["mu20"] / m["mu02"]) if m["mu02"] > 0 else 1.0
         blobs.append(Blob(u, v, r, aspect))
@@ -448,12 +476,13 @@ def find_aruco(image: np.ndarray) -> list[Blob]:
 
 def find_markers(left: np.ndarray, right: np.ndarray, kind: str = "disc",
                  max_row_error: float = 2.0, windows: tuple[Window, Window] | None = None,
-                 window: int = 31) -> list[MarkerPair]:
+                 window: int = 31, recentre: int = RECENTRE) -> list[MarkerPair]:
     """Candidate marker pairs in a rectified pair: a left blob and a right blob on the same row
     to its left (positive disparity) with a similar size. windows: ((x0, y0, x1, y1) left,
-    (x0, y0, x1, y1) right) to search in, else the whole images."""
+    (x0, y0, x1, y1) right) to search in, else the whole images. recentre: find_discs'."""
     def find(img: np.ndarray) -> list[Blob]:
-        return find_aruco(img) if kind == "aruco" else find_discs(img, window=window)
+        return find_aruco(img) if kind == "aruco" else find_discs(img, window=window,
+                                                                  recentre=recentre)
 
     found: list[list[Blob]] = []
     for img, win in zip((left, right), windows or (None, None)):
@@ -483,12 +512,13 @@ def _window(blob: Blob, shape: tuple[int, ...]) -> Window:
 
 def marker_candidates(left: np.ndarray, right: np.ndarray, kind: str = "disc",
                       radius_m: float | None = None, baseline_m: float | None = None,
-                      near: MarkerPair | None = None, whole: bool = False) -> list[MarkerPair]:
+                      near: MarkerPair | None = None, whole: bool = False,
+                      recentre: int = RECENTRE) -> list[MarkerPair]:
     """Marker pairs whose size fits their distance (a disc of radius_m at disparity d spans
     radius_m * d / baseline_m px; within 35%), best first: nearest to the last sighting `near`
     (searched for around it first, unless whole), else the largest. The neighbourhood the
     disc must be darker than grows with the disc: from the last sighting, or at 31 px and then,
-    if nothing is found, 121 px (a marker near the camera)."""
+    if nothing is found, 121 px (a marker near the camera). recentre: find_discs'."""
     def fits(p: MarkerPair) -> bool:
         if radius_m is None or baseline_m is None:
             return True
@@ -499,14 +529,15 @@ def marker_candidates(left: np.ndarray, right: np.ndarray, kind: str = "disc",
     if near is not None and not whole:
         windows = (_window(near.left, left.shape), _window(near.right, right.shape))
         size = max(31, 2 * int(3 * near.left.radius) + 1)
-        pairs = [p for p in find_markers(left, right, kind, windows=windows, window=size)
-                 if fits(p)]
+        pairs = [p for p in find_markers(left, right, kind, windows=windows, window=size,
+                                         recentre=recentre) if fits(p)]
     if not pairs:  # the whole views, in grey once for both sizes (pixel by pixel: the same)
         left, right = to_grey(left), to_grey(right)
     for size in (31, 121):
         if pairs:
             break
-        pairs = [p for p in find_markers(left, right, kind, window=size) if fits(p)]
+        pairs = [p for p in find_markers(left, right, kind, window=size, recentre=recentre)
+                 if fits(p)]
     if near is not None:
         return sorted(pairs, key=lambda p: abs(p.left.u - near.left.u)
                       + abs(p.left.v - near.left.v) + 10 * abs(p.disparity - near.disparity))

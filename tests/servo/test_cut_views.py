@@ -32,7 +32,8 @@ def test_a_disc_cut_by_a_nearer_edge_is_flagged(seed: int, x: float) -> None:
     found = _pairs(world, Renderer(world, CameraFaults(noise=2.5), seed=seed), 2.72, x)
     assert found, "the cut disc was not found at all: the scene no longer shows the case"
     for pair, error in found:
-        assert abs(error) > 0.5  # the centroids are off (0.6-0.9 px: 17-25 cm at 2.72 m)
+        assert abs(error) > 0.25  # the centroids are off (0.6-0.9 px: 17-25 cm at 2.72 m;
+        # re-centred, issue 23: 0.28-0.75 px)
         assert cut_views(pair), f"a cut disc {error:+.2f} px off passed as whole"
 
 
