@@ -1,14 +1,15 @@
 """Measure the card's signed turn (host/servo/card_turn.py) against the world's truth in whole
 trials: every frame the servo admits a marker pair, the disparity across the disc read from
 that frame's two views beside the robot's true heading and depth; the sign's error rate by
-|heading| (10/20/30/40 degrees: 5-15, 15-25, 25-35, 35-45) and depth. A diagnostic (session
-11, sign, issue 23): it wraps the servo's marker search and changes nothing in the servo.
+|turn from square| (the heading wrapped to -90..90 degrees: 10/20/30/40 are 5-15, 15-25,
+25-35, 35-45) and depth. A diagnostic (session 11, sign, issue 23): it wraps the servo's
+marker search and changes nothing in the servo.
 
     PYTHONPATH=. .venv/bin/python tools/trace_card_turn.py --seed S --index I [I ...]
         [--perspective]
 
 --perspective draws each view's disc with the width a turned card has in it (the near edge at
-the larger disparity: the left view's disc narrower by d 2 R sin(theta) / z when theta > 0),
+the larger disparity: the left view's disc wider by d 2 R sin(theta) / z when theta > 0),
 which the simulator does not model (host/sim/renderer.py draws one ellipse at one disparity in
 both views): what the sign would be worth with the simulator's noise if it did.
 """
@@ -23,7 +24,7 @@ from host.cli import build_parser
 from host.commands.options import params_from_args
 from host.commands.servo import parse_size  # type: ignore[attr-defined]
 from host.servo import loop as L
-from host.servo.card_turn import across_px, expected_px
+from host.servo.card_turn import across_px, expected_px, from_square
 from host.sim import renderer as R
 from host.sim import trials as T
 
@@ -35,7 +36,7 @@ opts = ap.parse_args()
 args = build_parser().parse_args(["servo", "--sim", "--trials", "1", "--seed", str(opts.seed)])
 params = params_from_args(args)
 st: dict[str, Any] = {"w": None}
-rows: list[tuple[float, float, float, float, float]] = []  # theta, z, aspect, across, expected
+rows: list[tuple[float, float, float, float, float]] = []  # turn, z, aspect, across, expected
 
 orig_search = L.Servo._search
 
@@ -47,9 +48,9 @@ def search(self: Any, frame: Any) -> Any:
         r = w.robot
         g = w.geometry
         d = g.focal_px * g.baseline_m / r.z_m
-        rows.append((r.theta, r.z_m, seen.pair.left.aspect,
+        rows.append((from_square(r.theta), r.z_m, seen.pair.left.aspect,
                      across_px(frame.left, frame.right, seen.pair),
-                     expected_px(r.theta, r.z_m, d, r.marker_radius_m)))
+                     expected_px(from_square(r.theta), r.z_m, d, r.marker_radius_m)))
     return seen
 
 
@@ -64,7 +65,8 @@ if opts.perspective:
         if abs(d - g.focal_px * g.baseline_m / r.z_m) < 1e-9 and rx >= 0.5:
             ul = self._project(r.x_m, r.marker_height_m, r.z_m)[0]
             shift = round((ul - u) / d)  # 0: the left view, 1: the right
-            delta = expected_px(r.theta, r.z_m, d, r.marker_radius_m)  # width_l - width_r
+            # width_left - width_right
+            delta = expected_px(from_square(r.theta), r.z_m, d, r.marker_radius_m)
             rx = rx + (delta / 4 if shift == 0 else -delta / 4)
         orig_marker(self, image, disp, u, v, rx, ry, d, ring)
 

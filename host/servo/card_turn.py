@@ -72,6 +72,13 @@ def across_px(left: np.ndarray, right: np.ndarray, pair: MarkerPair,
     return width * (a - b) / ((a + b) / 2)
 
 
+def from_square(theta: float) -> float:
+    """The card's signed turn from square to the camera axis, rad in (-pi/2, pi/2], for a body
+    heading theta (world frame; the card across the body, two-sided): the sign is the one
+    across_px reads (its +x edge nearer when positive), whichever way the body faces."""
+    return math.atan(math.tan(theta))
+
+
 def expected_px(turn_rad: float, depth_m: float, disparity_px: float, radius_m: float) -> float:
     """The disparity across a disc of radius_m turned by turn_rad at depth_m seen at
     disparity_px (d = f B / z): d(z - R sin) - d(z + R sin) ~ d 2 R sin(turn) / z."""

@@ -1,8 +1,10 @@
 """The card's signed turn from its two views (host/servo/card_turn.py, issue 23, branch sign):
-a disc drawn narrower in the left view than in the right (its +x edge nearer: the body turned
-toward +x) reads a positive disparity across, the other way negative, square about zero; the
-size of it within 20 % of the drawn difference. Seen failing with the coverages swapped in
-across_px (b - a: every sign wrong) and with the width left unscaled (a - b alone: sizes off).
+a disc drawn wider in the left view than in the right (its +x edge nearer, at the larger
+disparity: the body turned toward +x) reads a positive disparity across, the other way
+negative, square about zero; the size of it within 20 % of the drawn difference. Seen failing
+with the coverages swapped in across_px (b - a: every sign wrong), with the width left unscaled
+(a - b alone: sizes off), and with from_square returning theta as it is (a body facing the
+camera: its sign and size wrong).
 """
 
 import math
@@ -10,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from host.servo.card_turn import across_px, coverage, expected_px
+from host.servo.card_turn import across_px, coverage, expected_px, from_square
 from host.servo.marker import RING_RATIO, Blob, MarkerPair
 
 
@@ -60,3 +62,11 @@ def test_expected_size() -> None:
     # 30 degrees, 1.2 m, 20 px: 20 * 0.06 * 0.5 / 1.2 = 0.5 px across the disc
     assert expected_px(math.radians(30), 1.2, 20.0, 0.03) == pytest.approx(0.5)
     assert expected_px(math.radians(-30), 1.2, 20.0, 0.03) == pytest.approx(-0.5)
+
+
+@pytest.mark.parametrize("theta_deg,turn_deg", [(30, 30), (-30, -30), (150, -30), (-150, 30),
+                                                (210, 30), (0, 0)])
+def test_the_turn_from_square_whichever_way_the_body_faces(theta_deg: float,
+                                                           turn_deg: float) -> None:
+    # facing the camera (150 deg) the card's +x edge is its far one: the other sign
+    assert math.degrees(from_square(math.radians(theta_deg))) == pytest.approx(turn_deg)
