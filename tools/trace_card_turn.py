@@ -32,7 +32,9 @@ ap = argparse.ArgumentParser()
 ap.add_argument("--seed", type=int, required=True)
 ap.add_argument("--index", type=int, nargs="+", required=True)
 ap.add_argument("--perspective", action="store_true")
+ap.add_argument("--sure", type=float, default=0.3, help="px: a sign read as sure beyond it")
 opts = ap.parse_args()
+SURE_PX = opts.sure
 args = build_parser().parse_args(["servo", "--sim", "--trials", "1", "--seed", str(opts.seed)])
 params = params_from_args(args)
 st: dict[str, Any] = {"w": None}
@@ -106,7 +108,8 @@ for th, z, _a, ac, ex in rows:
         cells[(band(abs(math.degrees(th))), zband(z))].append((th, ac, ex))
 print(f"# frames {len(rows)} (read {sum(len(v) for v in cells.values())}), perspective "
       f"{opts.perspective}")
-print("|theta| deg  depth m   n   sign wrong   across px mean (sd)   expected px mean")
+print("|turn| deg  depth m   n   sign wrong   across px mean (sd)   expected px mean   "
+      f"|across| >= {SURE_PX} px: n, wrong")
 for key in sorted(cells):
     v = cells[key]
     wrong = sum(1 for th, ac, _ in v if ac * th < 0 or ac == 0)
@@ -114,5 +117,7 @@ for key in sorted(cells):
     mean = sum(signed) / len(v)
     sd = math.sqrt(sum((s - mean) ** 2 for s in signed) / max(1, len(v) - 1))
     exp = sum(abs(e) for _, _, e in v) / len(v)
+    sure = [(th, ac) for th, ac, _ in v if abs(ac) >= SURE_PX]
+    bad = sum(1 for th, ac in sure if ac * th < 0)
     print(f"{key[0]:>5}        {key[1]:>7} {len(v):4d}   {wrong / len(v):6.1%}     "
-          f"{mean:+7.3f} ({sd:.3f})          {exp:.3f}")
+          f"{mean:+7.3f} ({sd:.3f})          {exp:.3f}              {len(sure):4d}, {bad}")
