@@ -109,7 +109,7 @@ for th, z, _a, ac, ex in rows:
 print(f"# frames {len(rows)} (read {sum(len(v) for v in cells.values())}), perspective "
       f"{opts.perspective}")
 print("|turn| deg  depth m   n   sign wrong   across px mean (sd)   expected px mean   "
-      f"|across| >= {SURE_PX} px: n, wrong")
+      f"|across| >= {SURE_PX} px: n, wrong   turn < 0: n, wrong")
 for key in sorted(cells):
     v = cells[key]
     wrong = sum(1 for th, ac, _ in v if ac * th < 0 or ac == 0)
@@ -119,5 +119,7 @@ for key in sorted(cells):
     exp = sum(abs(e) for _, _, e in v) / len(v)
     sure = [(th, ac) for th, ac, _ in v if abs(ac) >= SURE_PX]
     bad = sum(1 for th, ac in sure if ac * th < 0)
+    neg = [ac for th, ac, _ in v if th < 0]
     print(f"{key[0]:>5}        {key[1]:>7} {len(v):4d}   {wrong / len(v):6.1%}     "
-          f"{mean:+7.3f} ({sd:.3f})          {exp:.3f}              {len(sure):4d}, {bad}")
+          f"{mean:+7.3f} ({sd:.3f})          {exp:.3f}              {len(sure):4d}, {bad}"
+          f"           {len(neg):4d}, {sum(1 for ac in neg if ac >= 0)}")
