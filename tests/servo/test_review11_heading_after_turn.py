@@ -12,8 +12,15 @@ from __future__ import annotations
 
 import math
 
-from host.servo.clearance import (Body, Heading, depth_noise_m, facing_shown, motion_heading,
-                                  run_fault, swept)
+from host.servo.clearance import (
+    Body,
+    Heading,
+    depth_noise_m,
+    facing_shown,
+    motion_heading,
+    run_fault,
+    swept,
+)
 from host.servo.perception import stopping_distance_m
 from tests.servo.test_clearance import _face
 
@@ -27,10 +34,14 @@ TRUE_BODY = Body(0.08, 0.08, 0.0)
 RUN_ON = SPEED * (0.25 + 0.08)  # the reaction and run-down after the check fires
 
 
-def _drive_after_spin(z0: float, x0: float, off_deg: float) -> tuple[int | None, float | None]:
+def _drive_after_spin(z0: float, x0: float, off_deg: float, shown: bool = True
+                      ) -> tuple[int | None, float | None]:
     """A spin at (z0, x0), then a drive toward the camera (facing_away False) on a true heading
     off_deg off the axis (positive: toward -x, box 2's end). The frame the check fires and
-    how far on (m) the true body meets a cell by the time it stands (None: clear)."""
+    how far on (m) the true body meets a cell by the time it stands (None: clear). shown: the
+    card's turn bound (loop.py passes the median of the controller's last three) is the true
+    turn, noise-free; else none is known."""
+    turned = math.radians(abs(off_deg)) if shown else None
     hd = Heading()
     t = 0.0
     for _ in range(10):
@@ -41,7 +52,7 @@ def _drive_after_spin(z0: float, x0: float, off_deg: float) -> tuple[int | None,
     for k in range(60):
         noise = depth_noise_m(z, SIGMA, FB, 1.0)
         hd.update(t, z, x, 600, 600, noise)
-        h, spread = motion_heading(hd, False)
+        h, spread = motion_heading(hd, False, turned)
         travel = stopping_distance_m(SPEED, margin_m=0.02)
         hit = run_fault(END, z, x, 600, 600, h, spread, travel, BODY, 0.12)
         if hit is None and not facing_shown(hd, False):
@@ -71,6 +82,13 @@ def test_the_same_turn_ended_20_degrees_toward_the_end() -> None:
     end met 0.10 m on at the 5 degrees)."""
     fired, met = _drive_after_spin(1.75, -0.12, 20.0)
     assert fired is not None and met is None, (fired, met)
+
+
+def test_with_no_turn_shown_the_spread_covers_a_turns_end() -> None:
+    """No sighting's turn bound: spun_spread (40 degrees) covers the 12-36 degrees seen."""
+    for x0, off in ((-0.10, 30.0), (-0.12, 20.0)):
+        fired, met = _drive_after_spin(1.75, x0, off, shown=False)
+        assert fired is not None and met is None, (x0, off, fired, met)
 
 
 def test_a_straight_drive_after_a_spin_well_clear_of_an_end_goes_on() -> None:
