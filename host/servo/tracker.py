@@ -200,6 +200,17 @@ class TargetTracker:
         lo, hi = old.disparity * (1 - self.cfg.same_depth), behind_px(old.disparity)
         band = np.where((disp >= lo) & (disp <= hi), disp, np.nan)
         cols = np.full_like(disp, np.nan)
+        try:  # something real at its depth or nearer in its columns (the target's own rest
+            # beside a walker read as 0 px, its views agreeing; a phantom's do not): it is no
+            # move (review11: the wall above that rest, 16 px, became the target)
+            cols[:, bx:bx + bw] = np.where(disp[:, bx:bx + bw] > hi, disp[:, bx:bx + bw],
+                                           np.nan)
+            if agreement(nearest_object(cols, self.min_area, near=old.disparity)) \
+                    >= self.cfg.still_there:
+                return None
+        except HostError:
+            pass
+        cols[:] = np.nan
         cols[:, bx:bx + bw] = band[:, bx:bx + bw]
         try:
             here = nearest_object(cols, self.min_area, near=old.disparity)
