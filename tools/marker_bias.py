@@ -4,8 +4,8 @@ standing at each depth, no events; the servo's own frame preparation (exposure, 
 marker search, the pair nearest the true marker taken. Printed per depth: the median disparity
 error (px, against the calibrated geometry's fB / z) of the centres taken once (before the mend)
 and re-centred (after), on the same frames, and of the block matching over the ring; the median
-depth error (cm) before and after, and the largest of the trials' medians. --camera picks the camera's faults: the
-trial's, without its lenses ("flat"), or flat and noiseless ("ideal").
+depth error (cm) before and after, and the largest of the trials' medians. --camera picks the
+camera's faults: the trial's, without its lenses ("flat"), or flat and noiseless ("ideal").
 
     .venv/bin/python tools/marker_bias.py --seeds 105 --indices 0-7 --depths 0.5,1,1.5,2,2.5,3
 """
