@@ -280,6 +280,23 @@ class Controller:
             cells = cells[~own]
         return np.concatenate([cells.reshape(-1, 2), self.kept]) if len(self.kept) else cells
 
+    def own(self) -> np.ndarray:
+        """The target's own fixed cells, which others() leaves out (the robot holds beside its
+        face): across its extent, nearer than own_depth_m behind the face."""
+        cells = self.fixed
+        if not len(cells) or self.keep_out is None:
+            return cells[:0].reshape(-1, 2)
+        x0, x1 = self.keep_out
+        c = self.cfg.cell_m
+        own = ((cells[:, 1] > x0 - c) & (cells[:, 1] < x1 + c)
+               & (cells[:, 0] < self.target_m + self.cfg.own_depth_m))
+        return cells[own].reshape(-1, 2)
+
+    def turn_bound(self) -> float:
+        """The body's turn off the camera axis (rad), either way, as the recent sightings
+        bound it (the median of saw's bounds; 0 with none): what reach_m turns the body by."""
+        return float(np.median(self.turns)) if self.turns else 0.0
+
     def ahead(self, depth_m: float) -> np.ndarray:
         """The other fixed objects' cells in the robot's path from depth_m to the target (to
         path_margin_m beyond it)."""
