@@ -18,7 +18,6 @@ the load.
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import os
 import statistics
 import sys
@@ -32,22 +31,7 @@ from host.stereo import MatcherParams, compute_disparity
 
 sys.path.insert(0, __file__.rsplit("/", 1)[0])
 from matcher import CALL_MS, SIZES, pair_params, parse_size, resized_pair  # noqa: E402
-
-
-def _cpu(fn, calls: int) -> float:  # type: ignore[no-untyped-def]
-    c0 = time.process_time()
-    for _ in range(calls):
-        fn()
-    return (time.process_time() - c0) * 1000 / calls
-
-
-def _load(name: str, path: str):  # type: ignore[no-untyped-def]
-    spec = importlib.util.spec_from_file_location(name, path)
-    assert spec is not None and spec.loader is not None
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules[name] = mod  # numba's cache rebuilds a kernel's environment by module name
-    spec.loader.exec_module(mod)
-    return mod
+from sgm_versus import _cpu, _load  # noqa: E402  (the same timing and loading as for SGM)
 
 
 def _load_avg() -> str:
