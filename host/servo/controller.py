@@ -273,24 +273,27 @@ class Controller:
         target's face) stay wherever they are: the new target may stand in front of it."""
         cells = self.fixed
         if len(cells) and self.keep_out is not None:
-            x0, x1 = self.keep_out
-            c = self.cfg.cell_m
-            own = ((cells[:, 1] > x0 - c) & (cells[:, 1] < x1 + c)
-                   & (cells[:, 0] < self.target_m + self.cfg.own_depth_m))
-            cells = cells[~own]
+            cells = cells[~self._own_mask(cells)]
         return np.concatenate([cells.reshape(-1, 2), self.kept]) if len(self.kept) else cells
+
+    def _own_mask(self, cells: np.ndarray) -> np.ndarray:
+        """Which cells are the target's own (keep_out set): across its extent, nearer than
+        own_depth_m behind its face."""
+        assert self.keep_out is not None
+        x0, x1 = self.keep_out
+        c = self.cfg.cell_m
+        own: np.ndarray = ((cells[:, 1] > x0 - c) & (cells[:, 1] < x1 + c)
+                           & (cells[:, 0] < self.target_m + self.cfg.own_depth_m))
+        return own
 
     def own(self) -> np.ndarray:
         """The target's own fixed cells, which others() leaves out (the robot holds beside its
-        face): across its extent, nearer than own_depth_m behind the face."""
+        face): _own_mask's."""
         cells = self.fixed
         if not len(cells) or self.keep_out is None:
             return cells[:0].reshape(-1, 2)
-        x0, x1 = self.keep_out
-        c = self.cfg.cell_m
-        own = ((cells[:, 1] > x0 - c) & (cells[:, 1] < x1 + c)
-               & (cells[:, 0] < self.target_m + self.cfg.own_depth_m))
-        return cells[own].reshape(-1, 2)
+        own: np.ndarray = cells[self._own_mask(cells)].reshape(-1, 2)
+        return own
 
     def turn_bound(self) -> float:
         """The body's turn off the camera axis (rad), either way, as the recent sightings

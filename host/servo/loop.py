@@ -872,8 +872,10 @@ class Servo:
         h, spread = motion_heading(self.heading, c.facing_away)
         if cmd.phase == Phase.PROBE:  # it ends once moved probe_m: that and its run-down
             travel = self.cfg.acquire.probe_m + speed * self.cfg.react_s + cfg.block_margin_m
-            inside = cfg.half_width_m - cfg.cell_m / 2
-            if (np.hypot(cells[:, 0] - s.z, cells[:, 1] - s.x) < inside).any():
+            def under(pts: np.ndarray) -> bool:  # a body cannot stand on these cells
+                inside = cfg.half_width_m - cfg.cell_m / 2
+                return bool((np.hypot(pts[:, 0] - s.z, pts[:, 1] - s.x) < inside).any())
+            if under(cells):
                 return ""  # a body cannot stand there: a disc on that object, not the robot's
                 # card (the probe finds it out, as it does not move)
             # no line check watches a probe beside the object: its face's cells are in the
@@ -881,7 +883,7 @@ class Servo:
             # way (seed 18 #98: turned 28 degrees after its find spin, 9 cm before the face
             # and 14 cm from its side, the probe's 6 cm ran the body's corner into the side)
             own = c.own()  # (a sighting inside it is a disc on it: not stopped by it)
-            if len(own) and not (np.hypot(own[:, 0] - s.z, own[:, 1] - s.x) < inside).any():
+            if len(own) and not under(own):
                 cells = np.concatenate([cells, own])
             if self.heading.value is None:
                 spread = max(spread, c.turn_bound())

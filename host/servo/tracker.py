@@ -135,20 +135,24 @@ class TargetTracker:
         nearer, agreeing in both views; None if there is none (a target moved farther waits
         for the whole map)."""
         old = self.target
-        bx, _, bw, _ = old.bbox
         lo = behind_px(old.disparity)  # farther: what lay behind it (a
         hi = old.disparity * (1 + self.cfg.same_depth)  # wall seen through its columns)
-        cols = np.full_like(disp, np.nan)
-        band = disp[:, bx:bx + bw]
-        cols[:, bx:bx + bw] = np.where((band >= lo) & (band <= hi), band, np.nan)
         try:
-            here = nearest_object(cols, self.min_area, near=old.disparity)
+            here = nearest_object(self._in_columns(disp, (disp >= lo) & (disp <= hi)),
+                                  self.min_area, near=old.disparity)
         except HostError:
             return None
         if not (lo <= here.disparity <= hi and agreement(here) >= self.cfg.still_there):
             return None
         # its depth only: the band of columns cuts its region, its extent stays as it was
         return Target(here.disparity, old.area, old.bbox, here.spread)
+
+    def _in_columns(self, disp: np.ndarray, keep: np.ndarray) -> np.ndarray:
+        """The map within the target's columns where keep holds, NaN elsewhere."""
+        bx, _, bw, _ = self.target.bbox
+        cols = np.full_like(disp, np.nan)
+        cols[:, bx:bx + bw] = np.where(keep[:, bx:bx + bw], disp[:, bx:bx + bw], np.nan)
+        return cols
 
     def update_found(self, found: Target) -> Target:
         """The target found again (moved or not): its disparity the median of the last
@@ -198,22 +202,19 @@ class TargetTracker:
         old = self.target
         bx, _, bw, _ = old.bbox
         lo, hi = old.disparity * (1 - self.cfg.same_depth), behind_px(old.disparity)
-        band = np.where((disp >= lo) & (disp <= hi), disp, np.nan)
-        cols = np.full_like(disp, np.nan)
+        behind = (disp >= lo) & (disp <= hi)
         try:  # something real at its depth or nearer in its columns (the target's own rest
             # beside a walker read as 0 px, its views agreeing; a phantom's do not): it is no
             # move (review11: the wall above that rest, 16 px, became the target)
-            cols[:, bx:bx + bw] = np.where(disp[:, bx:bx + bw] > hi, disp[:, bx:bx + bw],
-                                           np.nan)
-            if agreement(nearest_object(cols, self.min_area, near=old.disparity)) \
-                    >= self.cfg.still_there:
+            if agreement(nearest_object(self._in_columns(disp, disp > hi), self.min_area,
+                                        near=old.disparity)) >= self.cfg.still_there:
                 return None
         except HostError:
             pass
-        cols[:] = np.nan
-        cols[:, bx:bx + bw] = band[:, bx:bx + bw]
+        band = np.where(behind, disp, np.nan)
         try:
-            here = nearest_object(cols, self.min_area, near=old.disparity)
+            here = nearest_object(self._in_columns(disp, behind), self.min_area,
+                                  near=old.disparity)
             x0, x1 = here.bbox[0], here.bbox[0] + here.bbox[2]
             if not (x0 > bx or x1 < bx + bw):  # no edge of its own within its columns
                 here = nearest_object(band, self.min_area, near=here.disparity)
