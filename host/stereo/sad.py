@@ -237,25 +237,58 @@ def _edge(col, win, floor, idx, efloor, eidx, rc, out, yi, x_from, x_to, half, d
         out[yi, x] = dmin + nd - 1 - best - off
 
 
-@njit(cache=True, fastmath=True)
-def _row_outputs(col, win, zero, floor, idx, efloor, eidx, rc, out, yi, x_from, x_to,
-                 x_start, half, w, dmin, nd, uniqueness, fit, want_right):
-    """Slide the window over outputs x in [x_from, x_to) of one row, writing out[yi, x] (and,
-    want_right, each output's costs into rc for _right_row)."""
+@njit(cache=True, fastmath=True, inline="always")
+def _row_start(col, win, zero, x_from, x_to, x_start, half, w, dmin, nd, uniqueness):
+    """A row's outputs [x_from, x_to) begun: the window filled at the row's first output, and
+    its runs (fast_lo, fast_hi): outputs that need none of the edge rules, and (edge_lo,
+    edge_hi): those left of them with some candidates' right windows outside (kmin > 0); both
+    empty (at x_to) with a uniqueness test."""
     if x_from == x_start:
         win[:] = 0
         for xx in range(max(0, x_start - half), x_start + half):
             _slide(win, col[xx], zero)
-    # outputs that need none of the edge rules below
     fast_lo = max(x_from, half + 1, half + dmin + nd - 1)
     fast_hi = min(x_to, w - half)
-    # outputs left of those with some candidates' right windows outside (kmin > 0)
     edge_lo = max(x_from, half + 1, half + dmin)
     edge_hi = min(x_to, w - half, half + dmin + nd - 1)
     if uniqueness > 0.0 or fast_hi <= fast_lo:
         fast_lo = fast_hi = x_to
     if uniqueness > 0.0 or edge_hi <= edge_lo:
         edge_lo = edge_hi = x_to
+    return fast_lo, fast_hi, edge_lo, edge_hi
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _one_output(col, win, zero, floor, idx, rc, out, yi, x, half, w, dmin, nd, uniqueness, fit,
+                want_right):
+    """Output x by the plain rules: the window slid on by a column, the winner among the
+    candidates whose right window is inside the image, its uniqueness and fit."""
+    enter = col[x + half] if x + half < w else zero
+    leave = col[x - half - 1] if x - half - 1 >= 0 else zero
+    # the right window of disparity d starts at max(0, x - half) - d: keep it inside
+    dmax = max(0, x - half) - dmin
+    kmin = max(0, nd - 1 - dmax)
+    _slide(win, enter, leave)
+    if kmin == 0:
+        k, _ = _lowest(win, floor, idx)
+    else:
+        if dmax < 0:
+            return
+        k = _argmin(win, kmin, nd)
+    if want_right:
+        _keep_costs(rc, win, x, kmin, nd)
+    off, ok = _decide(win, k, kmin, nd, uniqueness, fit)
+    if ok:
+        out[yi, x] = dmin + nd - 1 - k - off
+
+
+@njit(cache=True, fastmath=True)
+def _row_outputs(col, win, zero, floor, idx, efloor, eidx, rc, out, yi, x_from, x_to,
+                 x_start, half, w, dmin, nd, uniqueness, fit, want_right):
+    """Slide the window over outputs x in [x_from, x_to) of one row, writing out[yi, x] (and,
+    want_right, each output's costs into rc for _right_row)."""
+    fast_lo, fast_hi, edge_lo, edge_hi = _row_start(col, win, zero, x_from, x_to, x_start,
+                                                    half, w, dmin, nd, uniqueness)
     x = x_from
     while x < x_to:
         if x == edge_lo:
@@ -268,24 +301,9 @@ def _row_outputs(col, win, zero, floor, idx, efloor, eidx, rc, out, yi, x_from, 
                       fit, want_right)
             x = fast_hi
             continue
-        enter = col[x + half] if x + half < w else zero
-        leave = col[x - half - 1] if x - half - 1 >= 0 else zero
-        # the right window of disparity d starts at max(0, x - half) - d: keep it inside
-        dmax = max(0, x - half) - dmin
-        kmin = max(0, nd - 1 - dmax)
+        _one_output(col, win, zero, floor, idx, rc, out, yi, x, half, w, dmin, nd, uniqueness,
+                    fit, want_right)
         x += 1
-        _slide(win, enter, leave)
-        if kmin == 0:
-            k, _ = _lowest(win, floor, idx)
-        else:
-            if dmax < 0:
-                continue
-            k = _argmin(win, kmin, nd)
-        if want_right:
-            _keep_costs(rc, win, x - 1, kmin, nd)
-        off, ok = _decide(win, k, kmin, nd, uniqueness, fit)
-        if ok:
-            out[yi, x - 1] = dmin + nd - 1 - k - off
 
 
 @njit(cache=True, fastmath=True)
@@ -494,18 +512,8 @@ def _vrun(col, win, floor, rc, out, yi, x_from, x_to, half, dmin, nd, ndv, fit, 
 def _row_outputs_u16(col, win, zero, floor, idx, efloor, rc, out, yi, x_from, x_to,
                      x_start, half, w, dmin, nd, ndv, uniqueness, fit, want_right):
     """_row_outputs with the interior and the edge in vectors (_vrun)."""
-    if x_from == x_start:
-        win[:] = 0
-        for xx in range(max(0, x_start - half), x_start + half):
-            _slide(win, col[xx], zero)
-    fast_lo = max(x_from, half + 1, half + dmin + nd - 1)
-    fast_hi = min(x_to, w - half)
-    edge_lo = max(x_from, half + 1, half + dmin)
-    edge_hi = min(x_to, w - half, half + dmin + nd - 1)
-    if uniqueness > 0.0 or fast_hi <= fast_lo:
-        fast_lo = fast_hi = x_to
-    if uniqueness > 0.0 or edge_hi <= edge_lo:
-        edge_lo = edge_hi = x_to
+    fast_lo, fast_hi, edge_lo, edge_hi = _row_start(col, win, zero, x_from, x_to, x_start,
+                                                    half, w, dmin, nd, uniqueness)
     x = x_from
     while x < x_to:
         if x == edge_lo:
@@ -519,23 +527,9 @@ def _row_outputs_u16(col, win, zero, floor, idx, efloor, rc, out, yi, x_from, x_
                   want_right, False)
             x = fast_hi
             continue
-        enter = col[x + half] if x + half < w else zero
-        leave = col[x - half - 1] if x - half - 1 >= 0 else zero
-        dmax = max(0, x - half) - dmin
-        kmin = max(0, nd - 1 - dmax)
+        _one_output(col, win, zero, floor, idx, rc, out, yi, x, half, w, dmin, nd, uniqueness,
+                    fit, want_right)
         x += 1
-        _slide(win, enter, leave)
-        if kmin == 0:
-            k, _ = _lowest(win, floor, idx)
-        else:
-            if dmax < 0:
-                continue
-            k = _argmin(win, kmin, nd)
-        if want_right:
-            _keep_costs(rc, win, x - 1, kmin, nd)
-        off, ok = _decide(win, k, kmin, nd, uniqueness, fit)
-        if ok:
-            out[yi, x - 1] = dmin + nd - 1 - k - off
 
 
 @njit(cache=True, parallel=True, fastmath=True)
