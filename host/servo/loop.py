@@ -46,6 +46,7 @@ from host.servo.clearance import (
     in_the_way,
     motion_heading,
     run_fault,
+    unshown_duties,
 )
 from host.servo.controller import (
     DRIFTED,
@@ -201,6 +202,11 @@ class ServoConfig:
     ring_ratio: float = RING_RATIO  # the marker's light ring, in disc radii (as printed)
     react_s: float = REACT_S  # a command's reaction and the wheels' run-down (the view's check)
     wheelbase_m: float = WHEELBASE_M  # the wheels' track: a duty difference bends the path
+    # a drive while the heading is unknown (a spin forgot it) is slowed to spun_duty where the
+    # body on the controller's facing within spun_spread_deg meets a fixed object's cell within
+    # the check's stopping distance and the chord that shows the heading (Servo._slow_unshown)
+    spun_duty: int = 300
+    spun_spread_deg: float = 40.0
     fixed_check: bool = True  # every motion against every other fixed object, in the plane
     # (Servo._fixed_fault); False: the check before it (a drive's path along the depth axis)
     timing: TimingConfig = field(default_factory=TimingConfig)
@@ -888,7 +894,7 @@ class Servo:
             if self.heading.value is None:
                 spread = max(spread, c.turn_bound())
         back = cmd.left + cmd.right < 0
-        body = Body(cfg.half_width_m, cfg.half_length_m, cfg.block_margin_m + cfg.cell_m / 2)
+        body = self._body()
         hit = run_fault(cells, s.z, s.x, cmd.left, cmd.right, h, spread, travel, body,
                         self.cfg.wheelbase_m)
         what = "probe" if cmd.phase == Phase.PROBE else "reversed leg" if back else "drive"
@@ -914,6 +920,33 @@ class Servo:
         if hit is None:
             return ""
         return f"{INTO_FIXED.format(what)} ({hit:.2f} m on)"
+
+    def _body(self) -> Body:
+        """The body as the fixed-object checks sweep it: grown by block_margin_m and half a
+        cell (the cells are where the reference put them)."""
+        assert self.controller is not None
+        cfg = self.controller.cfg
+        return Body(cfg.half_width_m, cfg.half_length_m, cfg.block_margin_m + cfg.cell_m / 2)
+
+    def _slow_unshown(self, cmd: Command) -> Command:
+        """A drive whose heading a spin forgot, slowed to spun_duty near a fixed object
+        (clearance.unshown_duties): the check (_fixed_fault) then fires, once the travel
+        shows the heading, within the slower run's stopping distance."""
+        est, c = self.estimator, self.controller
+        s = est.state
+        if s is None or c is None or not self.cfg.fixed_check or self.heading.value is not None:
+            return cmd
+        duty = abs(cmd.left + cmd.right) / 2
+        speed = max(math.hypot(s.vz, s.vx), est.cfg.max_speed_mps * duty / 1000)
+        g = self.geometry
+        left, right = unshown_duties(
+            self.heading, c.obstacles(s.z, s.x), s.z, s.x, cmd.left, cmd.right, c.facing_away,
+            stopping_distance_m(speed, margin_m=c.cfg.block_margin_m),
+            depth_noise_m(s.z, est.sigma_px, g.focal_px, g.baseline_m), self._body(),
+            self.cfg.wheelbase_m, math.radians(self.cfg.spun_spread_deg), self.cfg.spun_duty)
+        if (left, right) == (cmd.left, cmd.right):
+            return cmd
+        return Command(left, right, cmd.phase, cmd.error_m)
 
     def _path_fault(self, frame: StereoFrame, cmd: Command) -> str:
         """Why the command must not be sent and the run ends, or "": the marker's ring would
@@ -1516,6 +1549,8 @@ class Servo:
         if stand:  # the spin waits, standing, for the object's depth measured again (the
             # standing checks still watch it: a drift onto a fixed object or the object)
             cmd, invalid = Command(0, 0, Phase.WAIT, cmd.error_m), invalid or stand
+        if moving and cmd.phase in (Phase.DRIVE, Phase.CREEP) and self.backoff is None:
+            cmd = self._slow_unshown(cmd)
         fault = self._path_fault(frame, cmd) if moving else self._spin_fault(frame.t_left, cmd)
         if moving and cmd.left * cmd.right < 0:  # the probe's spin test: a spin, checked as
             fault = fault or self._spin_fault(frame.t_left, cmd)  # one (sweeps, aged depth)

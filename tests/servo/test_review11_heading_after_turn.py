@@ -5,18 +5,17 @@ chord of ~5 cm at 1.75 m). Seed 17's turns round ended 12-36 degrees off the axi
 (docs/servo.md, fixed2: 762, 763, 969, where the error lay away from box 2's end and the axis
 check stopped them falsely). Mirrored, toward the end, the axis check sees the end only once
 the heading is learnt, and at full speed the reaction and run-down then carry the turned body
-onto it. The mend (loop.py _slow_after_spin): such a drive runs at most spun_duty (300, half
-the drive's 600) until the heading is shown (review11, issue 23). Pure functions only: the
-check composed as _fixed_fault composes it, the robot moved on its true heading frame by
-frame, the estimate = the truth. The mend measured on dev seeds 1-4 x10 cost holds (36 -> 34,
-two "did not settle"; a 40-degree spread instead: 36 -> 32, four false fixed-object stops):
-the two cases are xfail (strict) until a mend that costs no holds lands."""
+onto it. The mend (loop.py Servo._slow_unshown, clearance.unshown_duties): such a drive runs
+at most spun_duty (300, half the drive's 600) while the heading is unknown, where the body on the
+facing within spun_spread_deg (40) meets a fixed cell within the check's stopping distance and
+the chord that shows the heading; elsewhere it runs as asked (a cap after every spin cost two dev
+holds, "did not settle"; the 40 degrees in the check itself four false fixed-object stops).
+Pure functions only: the check composed as _fixed_fault composes it, the robot moved on its true
+heading frame by frame, the estimate = the truth (turn12, issue 23)."""
 
 from __future__ import annotations
 
 import math
-
-import pytest
 
 from host.servo.clearance import (
     Body,
@@ -26,6 +25,7 @@ from host.servo.clearance import (
     motion_heading,
     run_fault,
     swept,
+    unshown_duties,
 )
 from host.servo.loop import ServoConfig
 from host.servo.perception import stopping_distance_m
@@ -39,8 +39,10 @@ DT = 1 / 30
 BODY = Body(0.08, 0.08, 0.02 + 0.01)  # half width, half length, block_margin_m + cell / 2
 TRUE_BODY = Body(0.08, 0.08, 0.0)
 REACT = 0.25 + 0.08  # the reaction and run-down after the check fires (stopping_distance_m)
-# the loop's cap on a drive after a spin (ServoConfig.spun_duty; before the mend: none)
-SPUN_DUTY = getattr(ServoConfig(), "spun_duty", 600)
+# the loop's cap on a drive after a spin near a fixed object (ServoConfig.spun_duty, within
+# spun_spread_deg of the facing; clearance.unshown_duties)
+SPUN_DUTY = ServoConfig().spun_duty
+SPUN_SPREAD = math.radians(ServoConfig().spun_spread_deg)
 
 
 def _drive_after_spin(z0: float, x0: float, off_deg: float) -> tuple[int | None, float | None]:
@@ -57,7 +59,10 @@ def _drive_after_spin(z0: float, x0: float, off_deg: float) -> tuple[int | None,
     z, x, done = z0, x0, 0.0
     for k in range(90):
         noise = depth_noise_m(z, SIGMA, FB, 1.0)
-        duty = 600 if hd.value is not None else min(600, SPUN_DUTY)
+        duty, _ = unshown_duties(hd, END, z, x, 600, 600, False,
+                                 stopping_distance_m(FULL, margin_m=0.02),
+                                 depth_noise_m(z, SIGMA, FB, 1.0), BODY, 0.12, SPUN_SPREAD,
+                                 SPUN_DUTY)
         speed = FULL * duty / 600
         hd.update(t, z, x, duty, duty, noise)
         h, spread = motion_heading(hd, False)
@@ -75,7 +80,6 @@ def _drive_after_spin(z0: float, x0: float, off_deg: float) -> tuple[int | None,
     return None, swept(END, z0, x0, true_h, done, TRUE_BODY)
 
 
-@pytest.mark.xfail(strict=True, reason="review11: the axis check after a spin (a50cb3f)")
 def test_a_drive_after_a_turn_ended_toward_an_end_stops_short_of_it() -> None:
     """At 1.75 m, the body's side 7 cm from box 2's end (clear along the axis by 4 cm beyond
     the check's margins), the turn round ended 30 degrees toward the end: the check must fire
@@ -86,7 +90,6 @@ def test_a_drive_after_a_turn_ended_toward_an_end_stops_short_of_it() -> None:
     assert met is None, f"the check fired at frame {fired}; the true body met the end {met} m on"
 
 
-@pytest.mark.xfail(strict=True, reason="review11: the axis check after a spin (a50cb3f)")
 def test_the_same_turn_ended_20_degrees_toward_the_end() -> None:
     """At 1.75 m, the side 5 cm from the end, 20 degrees off toward it: the same (at a50cb3f
     frame 4, the end met 0.10 m on)."""
