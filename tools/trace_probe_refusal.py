@@ -14,7 +14,7 @@ that shows its facing runs at least max(probe_m, 3 noise) and then its stop, so 
 start it reaches at least that plus the stop's travel; the check already looks probe_m plus
 the stop's travel ahead, no farther. A hit nearer than the stop's travel alone refuses any leg.
 
-Found with it (bbfffd6, 2026-12-05 03:20-03:26 UTC, load 11-19): two classes, neither mended
+Found with it (bbfffd6, 2026-12-05 03:16-03:25 UTC, load 11-19): two classes, neither mended
 by a shorter leg or the other way (the check looks both ways alike while the facing is unshown).
 Refused at the probe's start at the unknown 5 degrees: seed 3 #4 (own face cell 5.6 cm on
 toward the camera; clear within 3 degrees; noise 0.99 cm, the shortest showing leg reaches
