@@ -203,6 +203,18 @@ class BackOffConfig:
     # for. Level with the face, closing, the other way runs the body past the object's end:
     # with a gap below this it stops (seed 15 trial 857: gap 1.0 cm reckoned, the heading
     # 2.5 degrees estimated, 23.5 true: the turned corner hit the side going deeper)
+    # standing for the re-measure under a fitted push (update's pushed_m, reckoned over
+    # push_s: the controller's push_horizon_s), the push must leave the body clear until a
+    # back-off that begins now has taken it out of the side's depth (_out_s): the command's
+    # reaction (robot_model.REACT_S) and the body's turned half length at speed_mps (under
+    # the ~7 cm/s measured at duty 350: seed 17 trial 96, 7.3 cm in 1.02 s), judged every
+    # frame of the wait, not the whole horizon at its first (seed 17 trial 937: 2.1 cm at
+    # 0.86 cm/s, both ways clear by 3.3-3.6 cm in truth, stopped at once)
+    push_s: float = 3.0
+    react_s: float = 0.33
+    speed_mps: float = 0.06
+    half_width_m: float = 0.08  # the body (controller.ControlConfig's): the rectangle
+    half_length_m: float = 0.08  # front_clear turns
     coast_s: float = 0.5  # after the flip the body coasts the first way this long at most
     # (the wheels' latency, 60-120 ms, and run-down, 80 ms, at the back-off's ~8 cm/s): the
     # second way's closing counts from where its own travel begins (seed 17 trial 193: 0.9 cm
@@ -253,6 +265,20 @@ class BackOff:
         return (abs(e) >= self.block_m + cfg.clear_m + cfg.settle_m
                 or z < cfg.camera_m + cfg.camera_room_m)
 
+    def _out_s(self, e: float, turned_m: float, away: int) -> float:
+        """Standing for the re-measure (e: the robot's depth less the object's, not yet
+        confirmed), how long a back-off that began now would take to bring the body out of
+        the object's side's depth: toward the camera, the command's reaction and the
+        body's turned half length (half_width_m + turned_m, the reach) in front of the face
+        at speed_mps; push_s (the whole horizon the push is reckoned over: the rule as it
+        was) when it would back off deeper (beyond the face, or its line away from the
+        side that way), where the object's sides run back beside it all the way."""
+        cfg = self.cfg
+        if e > cfg.beyond_m or (away > 0 and e > -cfg.level_m):
+            return cfg.push_s
+        travel = max(0.0, cfg.half_width_m + max(0.0, turned_m) + e)
+        return min(cfg.push_s, cfg.react_s + travel / cfg.speed_mps)
+
     @property
     def way(self) -> int | None:
         """The way it backs off in depth: +1 away from the camera, -1 toward it, None
@@ -295,7 +321,8 @@ class BackOff:
                 t - self.seen_t > self.cfg.unseen_s and not self.outcome:
             self.outcome = DONE
         if not self.outcome and self.start_z is None and not confirmed and \
-                gap is not None and pushed_m > 0 and gap < pushed_m:
+                gap is not None and pushed_m > 0 and z is not None and \
+                gap < pushed_m * self._out_s(z - target_m, turned_m, away) / self.cfg.push_s:
             self.outcome = ("no safe way back: pushed toward the object's side while its "
                             "depth is measured again")
         if self.outcome or z is None or not confirmed:
@@ -336,6 +363,16 @@ class BackOff:
         beside = e > -cfg.level_m
         tight = gap is not None and gap < cfg.side_m
         near = raw is not None and raw < cfg.corner_m  # too near to pass the end turned
+        # in front of the face, going toward the camera: the body itself (the rectangle,
+        # turned any way within the card's bound), not its bounds across and in depth apart,
+        # clear of the side and what runs back from it by side_m from here until it is in
+        # front of the face, the centre closing as it has: neither closing nor at the side
+        # (seed 18 trial 46: the corner that reaches farthest across is not the one that
+        # reaches deepest; truly clear by 4.3 cm either way, stopped "closes on its side")
+        if not self.deeper and e < 0 and raw is not None:
+            slope = max(0.0, shrunk) / max(abs(z - self.start_z), 1e-3)
+            if front_clear(raw, e, turned_m, slope, cfg) >= cfg.side_m:
+                closing, level = False, False
         if beside and closing and (self.flipped or near):
             self.outcome = ("no safe way back: backing off either way closes on its side"
                             if self.flipped else
@@ -370,6 +407,62 @@ class BackOff:
         bend = 0.0 if beside else max(-abs(d) / 2, min(abs(d) / 2, steer))
         left, right = lifted(d * (1 - trim) - bend, d * (1 + trim) + bend, floor, d)
         return int(round(left)), int(round(right))
+
+
+def front_clear(raw: float, e: float, turned_m: float, slope: float,
+                cfg: BackOffConfig = BackOffConfig(), steps: int = 9) -> float:
+    """The least clearance (m) of the body, in front of the object's face or level with it
+    (e: the robot's depth less the face's, < 0 in front) backing off toward the camera, to
+    the object's region beside it (across from its side, at or behind its face: its sides
+    run back unseen): the rectangle (half_width_m across, half_length_m along) turned by any
+    angle within the bound the card gives (turned_m: how much farther across than half its
+    width it reaches), either way, its centre raw beyond half the width from the side's
+    line, from here on toward the camera until no part of it can be behind the face, the
+    centre closing on the side by slope a metre of depth (at least the bound's own slope).
+    Negative: the body overlaps the region."""
+    w, h = cfg.half_width_m, cfg.half_length_m
+    big = math.hypot(w, h)
+    bound = math.atan2(h, w) - math.acos(min(1.0, (w + max(0.0, turned_m)) / big))
+    slope = max(slope, math.tan(bound))
+    u0 = raw + w
+    least = math.inf
+    for k in range(steps):
+        a = bound * (2 * k / (steps - 1) - 1)
+        sa, ca = math.sin(a), math.cos(a)
+        corners = [(i * h * sa + j * w * ca, i * h * ca - j * w * sa)
+                   for i, j in ((1, 1), (1, -1), (-1, -1), (-1, 1))]
+        s = 0.0
+        while True:
+            u, v = u0 - slope * s, e - s
+            least = min(least, _rect_to_region([(u + du, v + dv) for du, dv in corners]))
+            if v + big < 0 or s > 0.5:
+                break
+            s += 0.01
+    return least
+
+
+def _rect_to_region(corners: list[tuple[float, float]]) -> float:
+    """The least distance from a convex polygon (corners in order, (u, v)) to the region
+    u <= 0, v >= 0 (the object beside the body: u across from its side, v behind its face);
+    negative (how deep, roughly) where they overlap."""
+    inside = [min(-u, v) for u, v in corners if u <= 0 <= v]
+    if inside:
+        return -max(inside)
+    n = len(corners)
+    cross = [(corners[(i + 1) % n][0] - u) * (0.0 - v) - (corners[(i + 1) % n][1] - v) * (0.0 - u)
+             for i, (u, v) in enumerate(corners)]
+    if all(c > 0 for c in cross) or all(c < 0 for c in cross):
+        return -1e-3  # the region's corner (the face's end) inside the body
+    least = math.inf
+    for i, (u1, v1) in enumerate(corners):
+        u2, v2 = corners[(i + 1) % n]
+        for k in range(17):
+            f = k / 16
+            u, v = u1 + f * (u2 - u1), v1 + f * (v2 - v1)
+            if u <= 0 <= v:
+                return 0.0  # an edge crosses the region between corners
+            least = min(least, math.hypot(max(u, 0.0), max(-v, 0.0)))
+    return least
 
 
 def away_by_heading(heading: float | None, spread: float, lateral_m: float | None,

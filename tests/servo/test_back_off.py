@@ -82,8 +82,10 @@ def test_the_target_measured_again_away_from_the_robot_ends_it_standing() -> Non
 def test_a_robot_turned_toward_the_side_backs_off_the_other_way() -> None:
     """Turned 27 degrees (seed 13 trial 105), backing off toward the camera takes it toward
     the object's side: it goes the other way, away from the camera, before its body
-    reaches the side."""
-    b, z, _, least, _ = _back_off(1.17, -0.05, math.radians(27), 1.2, push=-0.002)
+    reaches the side. Level with the face (3 cm in front of it, as the trial was, the body,
+    square as this robot's card shows it, clears the side's region on the way toward the
+    camera and goes on: recovery.front_clear, test_back_off_front_clear.py)."""
+    b, z, _, least, _ = _back_off(1.2, -0.05, math.radians(27), 1.2, push=-0.002)
     assert b.flipped
     assert b.outcome == DONE and z >= 1.2 + BLOCK
     assert least > 0.0

@@ -17,6 +17,7 @@ import pytest
 from host.servo.controller import LINE_BLOCKED, PUSHED, ControlConfig, Controller, Observation
 from host.servo.phase import Phase
 from host.servo.recovery import DONE, BackOff, BackOffConfig
+from tests.servo.rect_clear import rect_clear
 
 BLOCK = ControlConfig().block_m
 
@@ -125,14 +126,16 @@ def test_the_back_off_goes_on_until_settled_on_its_lane() -> None:
     assert b.outcome == DONE and 1.2 - z == pytest.approx(out + cfg.settle_m, abs=0.005)
 
 
-def test_a_turned_body_closing_backing_off_tries_the_other_way() -> None:
+def test_a_turned_body_closing_backing_off_goes_on_clear() -> None:
     """Seed 2 #6's back-off (dev): holding turned 12.5 degrees, 4.5 cm from the box's side by
     half the width, pushed toward it at 8 mm/s; backing off toward the camera closes on the
     side. The turned body reaches 1.5 cm more (turned_m): the rules judge the gap less it,
     but the pass by the end, whose corner_m is already the most any turn adds, takes the gap
     by half the width (counted twice, it stopped named, "backing off closes on the object's
-    side", without trying the other way). It backs off the other way, out of the object's
-    depth, its true turned body clear of the side all the way."""
+    side", without trying the other way). The body itself, the rectangle turned within the
+    card's bound, clears the side and what runs back from it on that way until it is in front
+    of the face (recovery.front_clear; before, it backed off the other way): it backs off on
+    toward the camera, out of the object's depth, its true turned body clear all the way."""
     box_x1, theta, push = -0.18, math.radians(12.5), -0.008
     turned = 0.08 * (math.cos(theta) + math.sin(theta)) - 0.08
     b, z, x, t, least = BackOff(BLOCK), 1.2, box_x1 + 0.08 + 0.045, 0.0, 1.0
@@ -142,7 +145,7 @@ def test_a_turned_body_closing_backing_off_tries_the_other_way() -> None:
         duty = (left + right) / 2
         v = 0.0 if abs(duty) <= 120 else math.copysign(0.35 * (abs(duty) - 120) / 880, duty)
         z, x = z + v * math.cos(theta) / 30, x + (v * math.sin(theta) + push) / 30
-        least = min(least, x - box_x1 - 0.08 - turned)
+        least = min(least, rect_clear(x, z, theta, box_x1, 1.2))
         t += 1 / 30
-    assert b.flipped and b.outcome == DONE and z >= 1.2 + BLOCK
-    assert least > 0.0
+    assert b.outcome == DONE and z <= 1.2 - BLOCK
+    assert least > 0.02
