@@ -203,16 +203,6 @@ class BackOffConfig:
     # for. Level with the face, closing, the other way runs the body past the object's end:
     # with a gap below this it stops (seed 15 trial 857: gap 1.0 cm reckoned, the heading
     # 2.5 degrees estimated, 23.5 true: the turned corner hit the side going deeper)
-    # standing for the re-measure under a fitted push (update's pushed_m, reckoned over
-    # push_s: the controller's push_horizon_s), the push must leave the body clear until a
-    # back-off that begins now has taken it out of the side's depth (_out_s): the command's
-    # reaction (robot_model.REACT_S) and the body's turned half length at speed_mps (under
-    # the ~7 cm/s measured at duty 350: seed 17 trial 96, 7.3 cm in 1.02 s), judged every
-    # frame of the wait, not the whole horizon at its first (seed 17 trial 937: 2.1 cm at
-    # 0.86 cm/s, both ways clear by 3.3-3.6 cm in truth, stopped at once)
-    push_s: float = 3.0
-    react_s: float = 0.33
-    speed_mps: float = 0.06
     half_width_m: float = 0.08  # the body (controller.ControlConfig's): the rectangle
     half_length_m: float = 0.08  # front_clear turns
     coast_s: float = 0.5  # after the flip the body coasts the first way this long at most
@@ -265,20 +255,6 @@ class BackOff:
         return (abs(e) >= self.block_m + cfg.clear_m + cfg.settle_m
                 or z < cfg.camera_m + cfg.camera_room_m)
 
-    def _out_s(self, e: float, turned_m: float, away: int) -> float:
-        """Standing for the re-measure (e: the robot's depth less the object's, not yet
-        confirmed), how long a back-off that began now would take to bring the body out of
-        the object's side's depth: toward the camera, the command's reaction and the
-        body's turned half length (half_width_m + turned_m, the reach) in front of the face
-        at speed_mps; push_s (the whole horizon the push is reckoned over: the rule as it
-        was) when it would back off deeper (beyond the face, or its line away from the
-        side that way), where the object's sides run back beside it all the way."""
-        cfg = self.cfg
-        if e > cfg.beyond_m or (away > 0 and e > -cfg.level_m):
-            return cfg.push_s
-        travel = max(0.0, cfg.half_width_m + max(0.0, turned_m) + e)
-        return min(cfg.push_s, cfg.react_s + travel / cfg.speed_mps)
-
     @property
     def way(self) -> int | None:
         """The way it backs off in depth: +1 away from the camera, -1 toward it, None
@@ -321,8 +297,7 @@ class BackOff:
                 t - self.seen_t > self.cfg.unseen_s and not self.outcome:
             self.outcome = DONE
         if not self.outcome and self.start_z is None and not confirmed and \
-                gap is not None and pushed_m > 0 and z is not None and \
-                gap < pushed_m * self._out_s(z - target_m, turned_m, away) / self.cfg.push_s:
+                gap is not None and pushed_m > 0 and gap < pushed_m:
             self.outcome = ("no safe way back: pushed toward the object's side while its "
                             "depth is measured again")
         if self.outcome or z is None or not confirmed:
