@@ -263,9 +263,19 @@ def motion_heading(heading: Heading, facing_away: bool) -> tuple[float, float]:
     return (0.0 if facing_away else math.pi), heading.unknown_spread
 
 
+def lifted(left: float, right: float, floor: float, sign: float) -> tuple[float, float]:
+    """The duties raised, both by the same amount in the direction sign (the arc kept), so
+    that neither wheel is below floor, the least duty that moves the robot."""
+    lift = floor - min(abs(left), abs(right))
+    if lift > 0:
+        return left + math.copysign(lift, sign), right + math.copysign(lift, sign)
+    return left, right
+
+
 def unshown_duties(heading: Heading, cells: np.ndarray, z: float, x: float, left: int,
                    right: int, facing_away: bool, travel_m: float, noise_m: float, body: Body,
-                   wheelbase_m: float, spread: float, cap: int) -> tuple[int, int]:
+                   wheelbase_m: float, spread: float, cap: int,
+                   floor: float) -> tuple[int, int]:
     """The duties for a run while its heading is not known (a spin forgot it: a turn round, a
     search, a find), at most cap on average where the body, on the controller's facing within
     spread (the turns end 12-36 degrees off the axis), meets a cell within travel_m (the check's
@@ -275,7 +285,10 @@ def unshown_duties(heading: Heading, cells: np.ndarray, z: float, x: float, left
     reaction and run-down carry a body turned 20-30 degrees onto a box's end (tests/servo/
     test_review11_heading_after_turn.py). Slowed only by a fixed object, not after every spin
     (a blanket cap cost two dev holds 'not settled'), and slowed, not stopped (a spread that
-    wide in the check itself stopped 4 of 40 dev trials falsely)."""
+    wide in the check itself stopped 4 of 40 dev trials falsely). No wheel below floor (the
+    controller's: the least duty that moves a wheel, lifted as its own commands are): a
+    steered (300, 900) scaled to (150, 450) stopped a wheel with a motor offset of 35, the
+    body pivoting far off the arc the check sweeps (review12)."""
     duty = abs(left + right) / 2
     if heading.value is not None or left * right < 0 or duty <= cap or not len(cells):
         return left, right
@@ -284,7 +297,8 @@ def unshown_duties(heading: Heading, cells: np.ndarray, z: float, x: float, left
     if run_fault(cells, z, x, left, right, h, spread, reach, body, wheelbase_m) is None:
         return left, right
     k = cap / duty
-    return int(round(left * k)), int(round(right * k))
+    lo, hi = lifted(left * k, right * k, floor, left + right)
+    return int(round(lo)), int(round(hi))
 
 
 def facing_shown(heading: Heading, facing_away: bool) -> bool:

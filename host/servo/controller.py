@@ -53,7 +53,7 @@ from typing import Any
 
 import numpy as np
 
-from host.servo.clearance import Body, in_the_way, own_body, run_fault
+from host.servo.clearance import Body, in_the_way, lifted, own_body, run_fault
 from host.servo.phase import Phase
 from host.servo.robot_model import MAX_SPEED_MPS, REACT_S, WHEELBASE_M
 
@@ -71,15 +71,6 @@ def lane_pd(way: float, drift_m: float, xdot_mps: float, gain: float, damping: f
     its sideways rate (xdot_mps; damping permille per cm/s), for a robot moving in depth the
     way way says (+1 away from the camera, -1 toward it)."""
     return way * (share * gain * 100 * drift_m + damping * 100 * xdot_mps) / 2
-
-
-def lifted(left: float, right: float, floor: float, sign: float) -> tuple[float, float]:
-    """The duties raised, both by the same amount in the direction sign (the arc kept), so
-    that neither wheel is below floor, the least duty that moves the robot."""
-    lift = floor - min(abs(left), abs(right))
-    if lift > 0:
-        return left + math.copysign(lift, sign), right + math.copysign(lift, sign)
-    return left, right
 
 
 @dataclass(frozen=True)

@@ -943,7 +943,8 @@ class Servo:
             self.heading, c.obstacles(s.z, s.x), s.z, s.x, cmd.left, cmd.right, c.facing_away,
             stopping_distance_m(speed, margin_m=c.cfg.block_margin_m),
             depth_noise_m(s.z, est.sigma_px, g.focal_px, g.baseline_m), self._body(),
-            self.cfg.wheelbase_m, math.radians(self.cfg.spun_spread_deg), self.cfg.spun_duty)
+            self.cfg.wheelbase_m, math.radians(self.cfg.spun_spread_deg), self.cfg.spun_duty,
+            c.floor)
         if (left, right) == (cmd.left, cmd.right):
             return cmd
         return Command(left, right, cmd.phase, cmd.error_m)

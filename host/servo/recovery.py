@@ -44,7 +44,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from host.servo.controller import lane_pd, lifted
+from host.servo.clearance import lifted
+from host.servo.controller import lane_pd
 
 MOVED, RESET, LANE, STALE, OUTSIDE, TARGET, LOST, BESIDE = "moved", "reset", "lane", \
     "stale", "outside", "target", "lost", "beside"

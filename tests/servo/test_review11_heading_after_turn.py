@@ -27,6 +27,7 @@ from host.servo.clearance import (
     swept,
     unshown_duties,
 )
+from host.servo.controller import ControlConfig
 from host.servo.loop import ServoConfig
 from host.servo.perception import stopping_distance_m
 from tests.servo.test_clearance import _face
@@ -62,7 +63,7 @@ def _drive_after_spin(z0: float, x0: float, off_deg: float) -> tuple[int | None,
         duty, _ = unshown_duties(hd, END, z, x, 600, 600, False,
                                  stopping_distance_m(FULL, margin_m=0.02),
                                  depth_noise_m(z, SIGMA, FB, 1.0), BODY, 0.12, SPUN_SPREAD,
-                                 SPUN_DUTY)
+                                 SPUN_DUTY, ControlConfig().min_duty)
         speed = FULL * duty / 600
         hd.update(t, z, x, duty, duty, noise)
         h, spread = motion_heading(hd, False)
