@@ -10,6 +10,12 @@ Progress is either of:
     nothing against it, the re-measure taking the unseen robot's own body for it, restarts
     nothing: seed 11's trial 322);
   - a steady hold: holding hold_s without a break (each frame of it counts).
+A recovery (the phase "recover": a back-off from the object, a wait and a re-acquisition)
+begins an approach of its own: the least error is forgotten, and the errors measured after
+it, while they grow (backing off), set the new approach's start without counting as progress
+(seed 18 #62 held at 7.8 s, backed off 15 cm when pushed, came back on a new heading and was
+creeping in 1.2 cm from its target when "no progress in 20 s" ended the run: its least error
+was the hold's, before the back-off).
 No progress for stall_s while the servo commands (waits that recovery.py bounds do not count:
 the robot stands for a reason with its own limit) ends the run: the robot that oscillates
 about the target, creeps without closing in, holds only between frames without the marker, or
@@ -45,6 +51,7 @@ class Progress:
         self._paused = 0.0  # time in bounded waits since the last progress
         self._last_t: float | None = None
         self._measured = True  # an error measured since the goal began (the first goal counts)
+        self._fresh = False  # a recovery since the last progress: growing errors set the least
         self.last_phases: list[Phase] = []  # the phases since the last progress, in order
 
     def update(self, t: float, phase: Phase, error_m: float | None, target_m: float,
@@ -66,6 +73,8 @@ class Progress:
             self._measured = True
         if waiting:
             self._paused += dt
+        if phase == Phase.RECOVER:  # a new approach: its least error is its own
+            self.best, self._fresh = math.inf, True
         if phase == Phase.HOLD:
             self._hold_t0 = t if self._hold_t0 is None else self._hold_t0
             if t - self._hold_t0 >= cfg.hold_s:
@@ -73,7 +82,11 @@ class Progress:
         else:
             self._hold_t0 = None
         step = min(cfg.step_m, max(cfg.min_step_m, self.best / 2))
-        if error_m is not None and math.isfinite(error_m) and abs(error_m) < self.best - step:
+        if error_m is not None and math.isfinite(error_m) and self._fresh and (
+                not math.isfinite(self.best) or abs(error_m) > self.best):
+            self.best = abs(error_m)  # going away (the back-off): the approach starts farther
+        elif error_m is not None and math.isfinite(error_m) and abs(error_m) < self.best - step:
+            self._fresh = False
             self.best = abs(error_m)
             self._progress(t)
         if phase not in self.last_phases:

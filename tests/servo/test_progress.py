@@ -114,3 +114,24 @@ def test_the_servo_names_a_hold_it_cannot_keep_instead_of_running_out_of_time() 
     assert count[0] > 30, "the robot never reached the target: the case was not built"
     assert end.how == STOPPED and end.reason.startswith(NO_PROGRESS), end
     assert end.how != NOT_SETTLED
+
+
+def test_an_approach_after_a_recovery_is_measured_against_its_own_least() -> None:
+    """Seed 18 #62: held (error ~0), pushed, backed off 15 cm in a recovery, came back on a
+    new heading, and was creeping in 1.2 cm from its target when "no progress in 20 s" ended
+    the run: its least error was still the hold's. After a recovery the first error measured
+    is the new approach's least (no progress by itself), and closing in from it is progress."""
+    cfg = ProgressConfig(stall_s=5.0)
+    p = Progress(cfg)
+    frames: list[tuple[str, float | None]] = [("creep", 0.004)] * int(0.5 / DT)
+    frames += [("recover", None)] * int(0.5 / DT)
+    frames += [("drive", -0.15 * i * DT / 2) for i in range(int(2 / DT))]  # backed off 15 cm
+    n = int(12 / DT)
+    frames += [("drive", -0.15 + 0.14 * i / n) for i in range(n)]  # and in again, slowly
+    assert _run(p, frames) == (math.nan, "")
+    # the recovery alone, with no closing in after it, restarts nothing
+    p = Progress(cfg)
+    frames = [("creep", 0.004)] * int(0.5 / DT) + [("recover", None)] * int(0.5 / DT)
+    frames += [("drive", -0.15)] * int(8 / DT)
+    t, why = _run(p, frames)
+    assert why.startswith(NO_PROGRESS) and 4.9 < t < 5.2
