@@ -1424,11 +1424,23 @@ class Servo:
         times in all). Only frames where the estimator's gate admitted the marker count: the
         robot's region is left out where it stands now (the picture moved: where it was seen
         before the knock is rows off), and it is the robot the estimator followed (a pitch
-        changes neither the marker's disparity nor its column)."""
-        if pair is None or self.estimator.state is None:
+        changes neither the marker's disparity nor its column). Unseen (the robot stands in
+        the wait: a knock that came in a turn left its card edge-on, and seed 18 #2 waited the
+        whole 10 s for a sighting), the region of its last admitted sighting, with that region
+        moved by the picture's shift (the sighting may have come before the knock or after)."""
+        if self.estimator.state is None:
+            return False
+        if pair is not None:
+            box = self._robot_region(pair, frame.left.shape)
+        elif self.last_pair is not None and self._reference_image is not None:
+            box = self._robot_region(self.last_pair, frame.left.shape)
+            dy = round(vertical_shift_px(self._reference_image, frame.left))
+            h = frame.left.shape[0]
+            box = (box[0], max(0, min(box[1], box[1] + dy)), box[2],
+                   min(h, max(box[3], box[3] + dy)))
+        else:
             return False
         disp = compute_disparity(frame.left, frame.right, self.params)
-        box = self._robot_region(pair, frame.left.shape)
         x0, y0, x1, y1 = box
         disp[y0:y1, x0:x1] = np.nan
         self._reref.append(disp)
