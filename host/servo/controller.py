@@ -138,12 +138,14 @@ class ControlConfig:
     # the sideways push (m/s, +x) that ended a hold in this run (_pushed): measured, not set.
     # It rides in the config because a back-off's re-acquire keeps the config and makes the
     # controller anew (loop.Servo._reacquire). The lane back beside the object is planned
-    # wider on the side it pushes toward by what it closes over push_horizon_s (at most
-    # push_room_m): held there, the push check fires that much later (seed 18 #157, #211,
-    # #295 at a199819: pushed at 0.75-0.94 cm/s, backed off, came back to a lane no wider
-    # and were pushed again 10-20 s later, then too late for a back-off)
+    # push_room_m wider on the side it pushes toward: held there, the push check fires that
+    # much later (seed 18 #157, #211, #295 at a199819: pushed at 0.75-0.94 cm/s, backed off,
+    # came back to a lane no wider and were pushed again on arriving, then too late for a
+    # back-off). A bounded room, not the fitted rate over push_horizon_s: #295's fit read
+    # 0.39 cm/s of a true 0.75 (1.2 cm of room: pushed again on arriving), and the creep in
+    # (unsteered, 3 s) drifts with the push before the hold begins
     pushed_mps: float = 0.0
-    push_room_m: float = 0.04
+    push_room_m: float = 0.03
     unseen_horizon_s: float = 6.0  # the same with the card unseen: the last position moved on
     # by the last rate is a guess (the card's offset from the body, a rate from few sightings)
     mode: str = "turn"  # or "reverse"
@@ -349,10 +351,8 @@ class Controller:
 
     def push_room(self) -> float:
         """The room (m) the lane keeps beyond clearance_m from the side a push measured in
-        this run (pushed_mps) comes toward: what it closes over push_horizon_s, at most
-        push_room_m."""
-        cfg = self.cfg
-        return min(cfg.push_room_m, abs(cfg.pushed_mps) * cfg.push_horizon_s)
+        this run (pushed_mps) comes toward: push_room_m, or none without one."""
+        return self.cfg.push_room_m if self.cfg.pushed_mps else 0.0
 
     def _lane(self, x: float, depth_m: float | None, room: float, push: float = 0.0) -> float:
         """The lane from the first seen lateral x: clear of the object by clearance_m (and
