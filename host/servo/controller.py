@@ -48,7 +48,7 @@ after lost_frames of them the phase is "lost" (stopped) until the marker returns
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -135,16 +135,13 @@ class ControlConfig:
     push_horizon_s: float = 3.0  # standing, a sideways drift that would bring the body onto
     # the object within this long ends the run (it cannot move sideways in place)
     drift_s: float = 3.0  # the sideways drift beside the object is fitted over this long
-    # the sideways push (m/s, +x) that ended a hold in this run (_pushed): measured, not set.
-    # It rides in the config because a back-off's re-acquire keeps the config and makes the
-    # controller anew (loop.Servo._reacquire). The lane back beside the object is planned
-    # push_room_m wider on the side it pushes toward: held there, the push check fires that
-    # much later (seed 18 #157, #211, #295 at a199819: pushed at 0.75-0.94 cm/s, backed off,
-    # came back to a lane no wider and were pushed again on arriving, then too late for a
-    # back-off). A bounded room, not the fitted rate over push_horizon_s: #295's fit read
-    # 0.39 cm/s of a true 0.75 (1.2 cm of room: pushed again on arriving), and the creep in
-    # (unsteered, 3 s) drifts with the push before the hold begins
-    pushed_mps: float = 0.0
+    # the lane back beside the object after a push (Controller.pushed_mps, measured in this
+    # run) is planned push_room_m wider on the side it pushes toward: held there, the push
+    # check fires that much later (seed 18 #157, #211, #295 at a199819: pushed at 0.75-0.94
+    # cm/s, backed off, came back to a lane no wider and were pushed again on arriving, then
+    # too late for a back-off). A bounded room, not the fitted rate over push_horizon_s: #295's
+    # fit read 0.39 cm/s of a true 0.75 (1.2 cm of room: pushed again on arriving), and the
+    # creep in (unsteered, 3 s) drifts with the push before the hold begins
     push_room_m: float = 0.03
     unseen_horizon_s: float = 6.0  # the same with the card unseen: the last position moved on
     # by the last rate is a guess (the card's offset from the body, a rate from few sightings)
@@ -235,6 +232,10 @@ class Controller:
         self.history: list[Observation] = []  # valid observations since the last turn
         # the recent sightings' bounds on the body's turn off the camera axis (rad; saw)
         self.turns: list[float] = []
+        # the sideways push (m/s, +x) that ended a hold in this run (_pushed), 0 without one:
+        # a back-off's re-acquire carries it to the controller it makes anew (loop.Servo.
+        # _reacquire), whose lane back is planned wider on its side (push_room)
+        self.pushed_mps = 0.0
         self._turn: dict[str, Any] | None = None
         self._search_until: float | None = None
         self._seen_run = 0  # frames the card has been seen running
@@ -352,14 +353,14 @@ class Controller:
     def push_room(self) -> float:
         """The room (m) the lane keeps beyond clearance_m from the side a push measured in
         this run (pushed_mps) comes toward: push_room_m, or none without one."""
-        return self.cfg.push_room_m if self.cfg.pushed_mps else 0.0
+        return self.cfg.push_room_m if self.pushed_mps else 0.0
 
     def _lane(self, x: float, depth_m: float | None, room: float, push: float = 0.0) -> float:
         """The lane from the first seen lateral x: clear of the object by clearance_m (and
         push more on the side pushed_mps pushes toward) and of the other fixed objects ahead
         (given depth_m) by clearance_m + room, centre to side."""
         c = self.cfg.clearance_m
-        v = self.cfg.pushed_mps
+        v = self.pushed_mps
         spans = [] if self.keep_out is None else [
             (self.keep_out[0] - c - (push if v > 0 else 0.0),
              self.keep_out[1] + c + (push if v < 0 else 0.0))]
@@ -455,8 +456,8 @@ class Controller:
         t0, lateral, rate = fit
         if not self.closing(lateral + rate * (t - t0), rate, seen):
             return False
-        if seen and abs(rate) > abs(self.cfg.pushed_mps):
-            self.cfg = replace(self.cfg, pushed_mps=rate)  # the lane back is planned wider
+        if seen and abs(rate) > abs(self.pushed_mps):
+            self.pushed_mps = rate  # the lane back is planned wider
         return True
 
     def closing(self, lateral: float, rate: float, seen: bool = True) -> bool:

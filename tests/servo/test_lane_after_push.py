@@ -1,5 +1,5 @@
 """The lane back beside the object after a sideways push ended a hold (controller.Controller.
-lane, ControlConfig.pushed_mps): planned wider on the side the measured push comes toward, by
+lane, Controller.pushed_mps): planned wider on the side the measured push comes toward, by
 more than it closes over the push horizon (seed 18 #157, #211, #295 at a199819: pushed at
 0.75-0.94 cm/s, backed off, came back onto a lane no wider and were pushed again on
 arriving). Never on the other side, never nearer another fixed object than the lane keeps
@@ -31,6 +31,7 @@ def again(old: Controller, first_seen: float, fixed: np.ndarray | None = None) -
     """The controller made anew after the back-off, as loop.Servo._reacquire makes it."""
     c = Controller(old.target_m)
     c.cfg, c.keep_out, c.trim, c.facing_away = old.cfg, old.keep_out, old.trim, old.facing_away
+    c.pushed_mps = old.pushed_mps
     if fixed is not None:
         c.fixed = fixed
     c.lateral_ref = first_seen
