@@ -135,6 +135,14 @@ class ControlConfig:
     push_horizon_s: float = 3.0  # standing, a sideways drift that would bring the body onto
     # the object within this long ends the run (it cannot move sideways in place)
     drift_s: float = 3.0  # the sideways drift beside the object is fitted over this long
+    # the lane back beside the object after a push (Controller.pushed_mps, measured in this
+    # run) is planned push_room_m wider on the side it pushes toward: held there, the push
+    # check fires that much later (seed 18 #157, #211, #295 at a199819: pushed at 0.75-0.94
+    # cm/s, backed off, came back to a lane no wider and were pushed again on arriving, then
+    # too late for a back-off). A bounded room, not the fitted rate over push_horizon_s: #295's
+    # fit read 0.39 cm/s of a true 0.75 (1.2 cm of room: pushed again on arriving), and the
+    # creep in (unsteered, 3 s) drifts with the push before the hold begins
+    push_room_m: float = 0.03
     unseen_horizon_s: float = 6.0  # the same with the card unseen: the last position moved on
     # by the last rate is a guess (the card's offset from the body, a rate from few sightings)
     mode: str = "turn"  # or "reverse"
@@ -224,6 +232,10 @@ class Controller:
         self.history: list[Observation] = []  # valid observations since the last turn
         # the recent sightings' bounds on the body's turn off the camera axis (rad; saw)
         self.turns: list[float] = []
+        # the sideways push (m/s, +x) that ended a hold in this run (_pushed), 0 without one:
+        # a back-off's re-acquire carries it to the controller it makes anew (loop.Servo.
+        # _reacquire), whose lane back is planned wider on its side (push_room)
+        self.pushed_mps = 0.0
         self._turn: dict[str, Any] | None = None
         self._search_until: float | None = None
         self._seen_run = 0  # frames the card has been seen running
@@ -308,20 +320,50 @@ class Controller:
         x = self.lateral_ref
         if x is None:
             return x
-        plain = self._lane(x, depth_m, 0.0)
+        base = self._planned(x, depth_m, 0.0)
+        push = self.push_room()
+        if push <= 0 or self.keep_out is None:
+            return base
+        # a push measured in this run (pushed_mps): its side of the object kept push_room
+        # farther, where that lane is the one moved away from the object by at most that room
+        # and no nearer another fixed object ahead than before (or than the lane keeps them)
+        far = self._planned(x, depth_m, push)
+        x0, x1 = self.keep_out
+        away = far - base if base >= x1 else base - far if base <= x0 else -1.0
+        if not 0.0 <= away <= push + 1e-9:
+            return base
+        if depth_m is not None:
+            u = self.ahead(depth_m)[:, 1]
+            keep = self.cfg.clearance_m + self.cfg.spread_room_m + self.cfg.cell_m / 2
+            if len(u) and np.min(np.abs(u - far)) < min(np.min(np.abs(u - base)), keep):
+                return base
+        return far
+
+    def _planned(self, x: float, depth_m: float | None, push: float) -> float:
+        """The lane (lane) with push more room from the side pushed_mps pushes toward."""
+        plain = self._lane(x, depth_m, 0.0, push)
         room = self.cfg.spread_room_m
         if depth_m is None or room <= 0:
             return plain
         # with spread_room_m more from the other fixed objects, where that lane is the same
         # one moved by at most that room (a gap it closes, or a side it changes, is not taken)
-        wide = self._lane(x, depth_m, room)
+        wide = self._lane(x, depth_m, room, push)
         return wide if abs(wide - plain) <= room + 1e-9 else plain
 
-    def _lane(self, x: float, depth_m: float | None, room: float) -> float:
-        """The lane from the first seen lateral x: clear of the object by clearance_m and of
-        the other fixed objects ahead (given depth_m) by clearance_m + room, centre to side."""
+    def push_room(self) -> float:
+        """The room (m) the lane keeps beyond clearance_m from the side a push measured in
+        this run (pushed_mps) comes toward: push_room_m, or none without one."""
+        return self.cfg.push_room_m if self.pushed_mps else 0.0
+
+    def _lane(self, x: float, depth_m: float | None, room: float, push: float = 0.0) -> float:
+        """The lane from the first seen lateral x: clear of the object by clearance_m (and
+        push more on the side pushed_mps pushes toward) and of the other fixed objects ahead
+        (given depth_m) by clearance_m + room, centre to side."""
         c = self.cfg.clearance_m
-        spans = [] if self.keep_out is None else [(self.keep_out[0] - c, self.keep_out[1] + c)]
+        v = self.pushed_mps
+        spans = [] if self.keep_out is None else [
+            (self.keep_out[0] - c - (push if v > 0 else 0.0),
+             self.keep_out[1] + c + (push if v < 0 else 0.0))]
         if depth_m is not None:
             r = c + room + self.cfg.cell_m / 2
             spans += [(float(u) - r, float(u) + r) for u in self.ahead(depth_m)[:, 1]]
@@ -412,7 +454,11 @@ class Controller:
         if fit is None:
             return False
         t0, lateral, rate = fit
-        return self.closing(lateral + rate * (t - t0), rate, seen)
+        if not self.closing(lateral + rate * (t - t0), rate, seen):
+            return False
+        if seen and abs(rate) > abs(self.pushed_mps):
+            self.pushed_mps = rate  # the lane back is planned wider
+        return True
 
     def closing(self, lateral: float, rate: float, seen: bool = True) -> bool:
         """Whether a body at this lateral position, drifting sideways at this rate (m/s), is

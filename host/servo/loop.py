@@ -1411,6 +1411,7 @@ class Servo:
             old.facing_away
         c.fixed, c.kept = old.fixed, old.kept
         c.turns = list(old.turns)  # the body's turn as the card showed it (reach_m)
+        c.pushed_mps = old.pushed_mps  # a push measured in this run widens the lane back
         self.controller = c
         self._cmd = Command(0, 0, Phase.WAIT, None)
         # the drives, turns and losses before it belong to a heading the probe sets afresh
