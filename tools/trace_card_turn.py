@@ -17,8 +17,9 @@ both views): what the sign would be worth with the simulator's noise if it did.
 import argparse
 import math
 from collections import defaultdict
-from contextlib import contextmanager
 from typing import Any
+
+from trace_world import keep_world
 
 from host.cli import build_parser
 from host.commands.options import params_from_args
@@ -74,17 +75,7 @@ if opts.perspective:
 
     R.Renderer._marker = marker  # type: ignore[method-assign]
 
-orig_sim = T.simulation  # type: ignore[attr-defined]
-
-
-@contextmanager
-def sim2(*a: Any, **k: Any) -> Any:
-    with orig_sim(*a, **k) as s:
-        st["w"] = s.world
-        yield s
-
-
-T.simulation = sim2  # type: ignore[attr-defined]
+keep_world(st)
 
 for i in opts.index:
     tr = T.run_trial((opts.seed, i, parse_size(args.size), params, False))

@@ -4,7 +4,8 @@ stand's start and end."""
 
 import math
 import sys
-from contextlib import contextmanager
+
+from trace_world import keep_world
 
 from host.cli import build_parser
 from host.commands.options import params_from_args
@@ -91,17 +92,7 @@ def ds(self, t, cmd, fault):
 
 L.Servo._spin_fault = sf
 L.Servo._drift_stand = ds
-orig_sim = T.simulation
-
-
-@contextmanager
-def sim2(*a, **k):
-    with orig_sim(*a, **k) as s:
-        st["w"] = s.world
-        yield s
-
-
-T.simulation = sim2
+keep_world(st)
 tr = T.run_trial((seed, idx, parse_size(args.size), params, False))
 for t0, g0, vx, push, end in st["stands"]:
     print(f"STAND from {t0:.2f} s (true gap {g0:+.4f}, rate {vx * 100:+.2f} cm/s learnt driven,"

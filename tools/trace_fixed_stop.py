@@ -12,10 +12,10 @@ servo's methods and changes nothing.
 
 import math
 import sys
-from contextlib import contextmanager
 from typing import Any
 
 import numpy as np
+from trace_world import keep_world
 
 from host.cli import build_parser
 from host.commands.options import params_from_args
@@ -109,17 +109,7 @@ def fixed(self: Any, t: float, cmd: Any) -> str:
 
 
 L.Servo._fixed_fault = fixed  # type: ignore[method-assign]
-orig_sim = T.simulation  # type: ignore[attr-defined]
-
-
-@contextmanager
-def sim2(*a: Any, **k: Any) -> Any:
-    with orig_sim(*a, **k) as s:
-        st["w"] = s.world
-        yield s
-
-
-T.simulation = sim2  # type: ignore[attr-defined]
+keep_world(st)
 n = int(sys.argv[sys.argv.index("--trials") + 1]) if "--trials" in sys.argv else 1000
 tr = T.run_trial((seed, idx, parse_size(args.size), params, False))
 stop = [f for f in st["fires"] if tr.reason and f[1] and tr.reason.endswith(f[1])]

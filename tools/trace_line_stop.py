@@ -17,10 +17,10 @@ servo's model; the simulated box is the face alone).
 import json
 import math
 import sys
-from contextlib import contextmanager
 from typing import Any
 
 import numpy as np
+from trace_world import keep_world
 
 from host.cli import build_parser
 from host.commands.options import params_from_args
@@ -196,17 +196,7 @@ C.Controller.update = c_update
 R.BackOff.update = bo_update
 L.Servo._spin_fault = sf
 L.Servo._decide = decide
-orig_sim = T.simulation
-
-
-@contextmanager
-def sim2(*a: Any, **k: Any) -> Any:
-    with orig_sim(*a, **k) as s:
-        st["w"] = s.world
-        yield s
-
-
-T.simulation = sim2
+keep_world(st)
 
 
 def main() -> None:

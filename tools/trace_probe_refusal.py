@@ -26,11 +26,10 @@ within 5 degrees, 0.00 m on within the chord's spread.
 
 import math
 import sys
-from collections.abc import Iterator
-from contextlib import contextmanager
 from typing import Any
 
 import numpy as np
+from trace_world import keep_world
 
 from host.cli import build_parser
 from host.commands.options import params_from_args
@@ -87,17 +86,7 @@ def fixed(self: Any, t: float, cmd: Any) -> str:
 
 
 L.Servo._fixed_fault = fixed  # type: ignore[method-assign]
-orig_sim = T.simulation  # type: ignore[attr-defined]
-
-
-@contextmanager
-def sim2(*a: Any, **k: Any) -> Iterator[Any]:
-    with orig_sim(*a, **k) as sim:
-        st["w"] = sim.world
-        yield sim
-
-
-T.simulation = sim2  # type: ignore[attr-defined]
+keep_world(st)
 tr = T.run_trial((seed, idx, parse_size(args.size), params, False))
 print("\n".join(st["lines"]) if st["lines"] else "no probe refused by a fixed object")
 print("OUTCOME", tr.outcome, tr.reason, f"start {tr.start_m:.3f} target {tr.target_m:.3f}")

@@ -10,8 +10,9 @@ marker search and changes nothing in the servo.
 
 import argparse
 import math
-from contextlib import contextmanager
 from typing import Any
+
+from trace_world import keep_world
 
 from host.cli import build_parser
 from host.commands.options import params_from_args
@@ -53,16 +54,6 @@ def search(self: Any, frame: Any) -> Any:
 
 
 L.Servo._search = search  # type: ignore[method-assign]
-orig_sim = T.simulation  # type: ignore[attr-defined]
-
-
-@contextmanager
-def sim2(*a: Any, **k: Any) -> Any:
-    with orig_sim(*a, **k) as s:
-        st["w"] = s.world
-        yield s
-
-
-T.simulation = sim2  # type: ignore[attr-defined]
+keep_world(st)
 tr = T.run_trial((opts.seed, opts.index, parse_size(args.size), params, False))
 print(f"# seed {opts.seed} #{opts.index}: {tr.outcome} {tr.reason}")
