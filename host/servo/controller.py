@@ -298,6 +298,12 @@ class Controller:
         own: np.ndarray = cells[self._own_mask(cells)].reshape(-1, 2)
         return own
 
+    def swept_body(self) -> Body:
+        """The body as the fixed-object checks sweep it: grown by block_margin_m and half a
+        cell (the cells are where the reference put them)."""
+        cfg = self.cfg
+        return Body(cfg.half_width_m, cfg.half_length_m, cfg.block_margin_m + cfg.cell_m / 2)
+
     def turn_bound(self) -> float:
         """The body's turn off the camera axis (rad), either way, as the recent sightings
         bound it (the median of saw's bounds; 0 with none): what reach_m turns the body by."""
@@ -427,7 +433,7 @@ class Controller:
         cells = self.obstacles(z, lateral)
         if not len(cells):
             return False
-        body = Body(cfg.half_width_m, cfg.half_length_m, cfg.block_margin_m + cfg.cell_m / 2)
+        body = self.swept_body()
         heading = 0.0 if self.facing_away else math.pi
         return run_fault(cells, z, lateral, cfg.max_duty, cfg.max_duty, heading,
                          math.radians(cfg.slow_spread_deg), cfg.turn_room_m, body,
@@ -681,7 +687,7 @@ class Controller:
             return None
         speed = cfg.max_speed_mps * abs(left + right) / 2000
         travel = cfg.block_margin_m + speed * (cfg.check_react_s + cfg.slow_lag_s)
-        body = Body(cfg.half_width_m, cfg.half_length_m, cfg.block_margin_m + cfg.cell_m / 2)
+        body = self.swept_body()
         heading = 0.0 if self.facing_away else math.pi
         return run_fault(cells, z, x, int(left), int(right), heading,
                          math.radians(cfg.slow_spread_deg), travel, body, cfg.wheelbase_m)

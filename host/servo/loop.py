@@ -39,7 +39,6 @@ from host.link.client import RobotLink, RobotReset
 from host.servo.acquire import NOT_MOVED, AcquireConfig, Acquisition
 from host.servo.align import aligned_disparity
 from host.servo.clearance import (
-    Body,
     Heading,
     depth_noise_m,
     facing_shown,
@@ -894,7 +893,7 @@ class Servo:
             if self.heading.value is None:
                 spread = max(spread, c.turn_bound())
         back = cmd.left + cmd.right < 0
-        body = self._body()
+        body = c.swept_body()
         hit = run_fault(cells, s.z, s.x, cmd.left, cmd.right, h, spread, travel, body,
                         self.cfg.wheelbase_m)
         what = "probe" if cmd.phase == Phase.PROBE else "reversed leg" if back else "drive"
@@ -921,13 +920,6 @@ class Servo:
             return ""
         return f"{INTO_FIXED.format(what)} ({hit:.2f} m on)"
 
-    def _body(self) -> Body:
-        """The body as the fixed-object checks sweep it: grown by block_margin_m and half a
-        cell (the cells are where the reference put them)."""
-        assert self.controller is not None
-        cfg = self.controller.cfg
-        return Body(cfg.half_width_m, cfg.half_length_m, cfg.block_margin_m + cfg.cell_m / 2)
-
     def _slow_unshown(self, cmd: Command) -> Command:
         """A drive whose heading a spin forgot, slowed to spun_duty near a fixed object
         (clearance.unshown_duties): the check (_fixed_fault) then fires, once the travel
@@ -942,7 +934,7 @@ class Servo:
         left, right = unshown_duties(
             self.heading, c.obstacles(s.z, s.x), s.z, s.x, cmd.left, cmd.right, c.facing_away,
             stopping_distance_m(speed, margin_m=c.cfg.block_margin_m),
-            depth_noise_m(s.z, est.sigma_px, g.focal_px, g.baseline_m), self._body(),
+            depth_noise_m(s.z, est.sigma_px, g.focal_px, g.baseline_m), c.swept_body(),
             self.cfg.wheelbase_m, math.radians(self.cfg.spun_spread_deg), self.cfg.spun_duty,
             c.floor)
         if (left, right) == (cmd.left, cmd.right):

@@ -45,7 +45,7 @@ import math
 from dataclasses import dataclass
 
 from host.servo.clearance import lifted
-from host.servo.controller import lane_pd
+from host.servo.controller import ControlConfig, lane_pd
 
 MOVED, RESET, LANE, STALE, OUTSIDE, TARGET, LOST, BESIDE = "moved", "reset", "lane", \
     "stale", "outside", "target", "lost", "beside"
@@ -204,8 +204,8 @@ class BackOffConfig:
     # for. Level with the face, closing, the other way runs the body past the object's end:
     # with a gap below this it stops (seed 15 trial 857: gap 1.0 cm reckoned, the heading
     # 2.5 degrees estimated, 23.5 true: the turned corner hit the side going deeper)
-    half_width_m: float = 0.08  # the body (controller.ControlConfig's): the rectangle
-    half_length_m: float = 0.08  # front_clear turns
+    half_width_m: float = ControlConfig.half_width_m  # the body: the rectangle front_clear
+    half_length_m: float = ControlConfig.half_length_m  # turns
     coast_s: float = 0.5  # after the flip the body coasts the first way this long at most
     # (the wheels' latency, 60-120 ms, and run-down, 80 ms, at the back-off's ~8 cm/s): the
     # second way's closing counts from where its own travel begins (seed 17 trial 193: 0.9 cm
